@@ -1,0 +1,41 @@
+#pragma once
+// A plain, dimension-free copy of the particle state at one instant: what output writers
+// (VTU), the crevasse measurement and the side-view figures read. Engine internals stay
+// behind Simulation<Dim>; this is the only particle data that crosses into analysis/.
+#include <array>
+#include <string>
+#include <vector>
+
+namespace crevasse {
+
+struct ParticleSnapshot {
+  int dim = 2;                 // 2: (x, z); 3: (x, y, z). z is up, x along flow.
+  double time_s = 0.0;         // simulated time [s]
+  double dx_m = 0.0;           // background grid spacing [m]
+  double softening_zeta = 0.0; // ζ in p_c = −c·exp(−ζ ε_v^p); 0 when softening is off
+  double tensile_strength_pa = 0.0;  // c [Pa]
+  double ice_thickness_m = 0.0;      // H_i [m]
+  double step_top_x_m = 0.0;   // x where the bed starts to drop (top of the step) [m]
+  double step_foot_x_m = 0.0;  // x where the ramp meets the downstream floor [m]
+  double particle_spacing_m = 0.0;   // initial spacing between particles along an axis [m]
+
+  // Bed profile z_b(x) as a polyline of (x, z) vertices, for drawing and surface checks.
+  std::vector<std::array<double, 2>> bed_profile;
+
+  // One entry per particle. y is empty in 2D.
+  std::vector<double> x, y, z;        // position [m]
+  std::vector<double> vx, vy, vz;     // velocity [m/s] (vy empty in 2D)
+  std::vector<double> eps_v_p;        // accumulated volumetric plastic strain ε_v^p [-]
+  std::vector<double> pressure_pa;    // p = −tr(τ)/d, compression positive [Pa]
+  std::vector<double> von_mises_pa;   // q = sqrt(3/2 dev τ : dev τ) [Pa]
+  std::vector<double> sigma_zz_pa;    // vertical Cauchy stress, tension positive [Pa]
+  std::vector<double> volume_m3;      // current volume (area in 2D, per unit depth) [m^3]
+
+  std::size_t size() const { return x.size(); }
+  // Fraction of strength lost, 1 − exp(−ζ ε_v^p) (SPEC §5); 0 with softening off.
+  double damage(std::size_t i) const;
+  // The x of the most downstream particle (the ice front) [m].
+  double front_x() const;
+};
+
+}  // namespace crevasse
