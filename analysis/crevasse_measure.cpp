@@ -1,0 +1,300 @@
+#include "analysis/crevasse_measure.hpp"
+
+#include <gsl/gsl_statistics_double.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "analysis/damage_clusters.hpp"
+#include "analysis/damage_criterion.hpp"
+
+namespace crevasse::analysis {
+
+namespace {
+
+void require(bool ok, const std::string& message) {
+  if (!ok) throw std::invalid_argument("crevasse measurement: " + message);
+}
+
+void require_positive(double value, const char* field) {
+  require(value > 0.0 && std::isfinite(value),
+          std::string(field) + " must be finite and > 0, got " + std::to_string(value));
+}
+
+void require_non_negative(double value, const char* field) {
+  require(value >= 0.0 && std::isfinite(value),
+          std::string(field) + " must be finite and >= 0, got " + std::to_string(value));
+}
+
+void check_arrays(const ParticleSnapshot& s) {
+  const std::size_t n = s.x.size();
+  require(s.dim == 2 || s.dim == 3, "snapshot dim must be 2 or 3, got " + std::to_string(s.dim));
+  require(s.z.size() == n, "snapshot z has " + std::to_string(s.z.size()) +
+                               " entries but x has " + std::to_string(n));
+  require(s.eps_v_p.size() == n, "snapshot eps_v_p has " + std::to_string(s.eps_v_p.size()) +
+                                     " entries but x has " + std::to_string(n));
+  if (s.dim == 3) {
+    require(s.y.size() == n, "3D snapshot y has " + std::to_string(s.y.size()) +
+                                 " entries but x has " + std::to_string(n));
+  }
+}
+
+QuartileSummary quartiles(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  // GSL interpolates linearly between order statistics (Hyndman–Fan type 7).
+  return {gsl_stats_quantile_from_sorted_data(values.data(), 1, values.size(), 0.25),
+          gsl_stats_quantile_from_sorted_data(values.data(), 1, values.size(), 0.50),
+          gsl_stats_quantile_from_sorted_data(values.data(), 1, values.size(), 0.75)};
+}
+
+QuartileSummary scaled(QuartileSummary q, double factor) {
+  return {q.q25 * factor, q.median * factor, q.q75 * factor};
+}
+
+// Per damaged cluster, what the crevasse test and the crevasse record need.
+struct ClusterTally {
+  std::size_t particle_count = 0;
+  double z_min = std::numeric_limits<double>::infinity();
+  std::size_t surface_count = 0;  // members within reach of the surface
+  double surface_x_sum = 0.0;
+  double surface_x_min = std::numeric_limits<double>::infinity();
+  double surface_x_max = -std::numeric_limits<double>::infinity();
+};
+
+// A crevasse during merging: its x-extent at the surface is kept to form the union.
+struct Candidate {
+  Crevasse crevasse;
+  double left_m = 0.0;
+  double right_m = 0.0;
+};
+
+}  // namespace
+
+ResolvedMeasureSettings resolve_measure_settings(const ParticleSnapshot& snapshot,
+                                                 const MeasureSettings& settings) {
+  check_arrays(snapshot);
+  const bool has_particles = snapshot.size() > 0;
+  ResolvedMeasureSettings r;
+  r.dim = snapshot.dim;
+  r.damage_threshold = settings.damage_threshold;
+  const DamageCriterion criterion = DamageCriterion::for_snapshot(
+      snapshot, settings.damage_threshold, settings.eps_v_p_threshold);
+  r.eps_v_p_threshold = criterion.eps_v_p_at_threshold();
+  r.threshold_from_softening = criterion.uses_softening();
+
+  r.dx_m = settings.dx_m.value_or(snapshot.dx_m);
+  r.ice_thickness_m = settings.ice_thickness_m.value_or(snapshot.ice_thickness_m);
+  if (has_particles) {
+    require_positive(r.dx_m, "dx (snapshot dx_m or MeasureSettings::dx_m)");
+    require_positive(r.ice_thickness_m,
+                     "ice thickness H_i (snapshot ice_thickness_m or MeasureSettings::ice_thickness_m)");
+  }
+  const double spacing_default = snapshot.particle_spacing_m > 0.0 ? snapshot.particle_spacing_m
+                                                                   : 0.5 * r.dx_m;
+  r.particle_spacing_m = settings.particle_spacing_m.value_or(spacing_default);
+  if (has_particles) {
+    require_positive(r.particle_spacing_m,
+                     "particle spacing (snapshot particle_spacing_m or MeasureSettings)");
+  }
+
+  require_non_negative(settings.resolution_floor_over_dx, "resolution_floor_over_dx");
+  require_positive(settings.link_distance_over_spacing, "link_distance_over_spacing");
+  require_non_negative(settings.surface_reach_over_dx, "surface_reach_over_dx");
+  require_non_negative(settings.window_margin_over_h, "window_margin_over_h");
+  require_non_negative(settings.surface_bridge_half_width_over_h,
+                       "surface_bridge_half_width_over_h");
+  require(settings.surface_smoothing_bins >= 1 && settings.surface_smoothing_bins % 2 == 1,
+          "surface_smoothing_bins must be an odd number >= 1 (centred average), got " +
+              std::to_string(settings.surface_smoothing_bins));
+  require(settings.fragmented_fraction > 0.0 && settings.fragmented_fraction <= 1.0,
+          "fragmented_fraction must lie in (0, 1], got " +
+              std::to_string(settings.fragmented_fraction));
+  r.resolution_floor_m = settings.resolution_floor_over_dx * r.dx_m;
+  r.link_distance_m = settings.link_distance_over_spacing * r.particle_spacing_m;
+  r.surface_reach_m = settings.surface_reach_over_dx * r.dx_m;
+  r.surface_smoothing_bins = settings.surface_smoothing_bins;
+  // Never narrower than one bin either side, so a one-bin crevasse is always bridged.
+  r.surface_bridge_half_width_m =
+      std::max(settings.surface_bridge_half_width_over_h * r.ice_thickness_m, r.dx_m);
+  r.lip_offset_m = (settings.surface_smoothing_bins / 2 + 1) * r.dx_m;
+  r.fragmented_fraction = settings.fragmented_fraction;
+
+  const double margin = settings.window_margin_over_h * r.ice_thickness_m;
+  r.window_explicit = settings.window_min_x_m.has_value() || settings.window_max_x_m.has_value();
+  r.window_min_x_m = settings.window_min_x_m.value_or(snapshot.step_foot_x_m + margin);
+  r.window_max_x_m = settings.window_max_x_m.value_or(snapshot.front_x() - margin);
+  require(std::isfinite(r.window_min_x_m) && std::isfinite(r.window_max_x_m),
+          "window bounds must be finite");
+
+  if (snapshot.dim == 3) {
+    require_positive(settings.y_band_width_over_dx, "y_band_width_over_dx");
+    r.y_band_width_m = settings.y_band_width_over_dx * r.dx_m;
+    if (settings.y_band_center_m) {
+      r.y_band_center_m = *settings.y_band_center_m;
+    } else if (has_particles) {
+      const auto [lo, hi] = std::minmax_element(snapshot.y.begin(), snapshot.y.end());
+      r.y_band_center_m = 0.5 * (*lo + *hi);
+    }
+  }
+  return r;
+}
+
+CrevasseMeasurement measure_crevasses(const ParticleSnapshot& snapshot,
+                                      const MeasureSettings& settings) {
+  CrevasseMeasurement m;
+  m.settings = resolve_measure_settings(snapshot, settings);
+  m.time_s = snapshot.time_s;
+  const ResolvedMeasureSettings& r = m.settings;
+  const DamageCriterion criterion = DamageCriterion::for_snapshot(
+      snapshot, settings.damage_threshold, settings.eps_v_p_threshold);
+
+  // The measured particles in the (x, z) plane: all of them in 2D, the central y-band in 3D.
+  std::vector<double> px, pz;
+  std::vector<std::uint8_t> damaged;
+  px.reserve(snapshot.size());
+  pz.reserve(snapshot.size());
+  damaged.reserve(snapshot.size());
+  for (std::size_t i = 0; i < snapshot.size(); ++i) {
+    if (snapshot.dim == 3 && std::abs(snapshot.y[i] - r.y_band_center_m) > 0.5 * r.y_band_width_m) {
+      continue;
+    }
+    require(std::isfinite(snapshot.x[i]) && std::isfinite(snapshot.z[i]),
+            "particle " + std::to_string(i) + " has a non-finite position; the snapshot is " +
+                "from a diverged run and cannot be measured");
+    px.push_back(snapshot.x[i]);
+    pz.push_back(snapshot.z[i]);
+    damaged.push_back(criterion.is_damaged(snapshot.eps_v_p[i]) ? 1 : 0);
+  }
+  m.particle_count = px.size();
+  m.damaged_particle_count = static_cast<std::size_t>(std::count(damaged.begin(), damaged.end(), 1));
+  const bool window_has_length = r.window_max_x_m > r.window_min_x_m;
+  auto in_window = [&](double x) { return x >= r.window_min_x_m && x <= r.window_max_x_m; };
+
+  if (px.empty()) {
+    m.flags.empty_snapshot = true;
+    m.flags.empty_window = true;
+    m.flags.no_crevasse = true;
+    return m;
+  }
+
+  const double half_spacing = 0.5 * r.particle_spacing_m;
+  m.surface = compute_surface_profile(px, pz, damaged,
+                                      {.bin_width_m = r.dx_m,
+                                       .bridge_half_width_m = r.surface_bridge_half_width_m,
+                                       .smoothing_bins = r.surface_smoothing_bins,
+                                       .particle_half_extent_m = half_spacing});
+
+  // Window occupancy and the share of it that is broken, for the "fragmented" flag.
+  std::size_t window_damaged = 0;
+  std::vector<std::uint8_t> bin_has_intact(m.surface.size(), 0);
+  std::vector<std::uint8_t> bin_has_any(m.surface.size(), 0);
+  for (std::size_t p = 0; p < px.size(); ++p) {
+    if (!window_has_length || !in_window(px[p])) continue;
+    ++m.window_particle_count;
+    window_damaged += damaged[p];
+    const auto b = std::min(m.surface.size() - 1,
+                            static_cast<std::size_t>(std::max(
+                                0.0, std::floor((px[p] - m.surface.x0_m) / r.dx_m))));
+    bin_has_any[b] = 1;
+    if (!damaged[p]) bin_has_intact[b] = 1;
+  }
+  m.flags.empty_window = m.window_particle_count == 0;
+  if (!m.flags.empty_window) {
+    const auto occupied = std::count(bin_has_any.begin(), bin_has_any.end(), 1);
+    const auto broken = occupied - std::count(bin_has_intact.begin(), bin_has_intact.end(), 1);
+    const double n_window = static_cast<double>(m.window_particle_count);
+    m.flags.fragmented =
+        static_cast<double>(window_damaged) >= r.fragmented_fraction * n_window ||
+        static_cast<double>(broken) > r.fragmented_fraction * static_cast<double>(occupied);
+  }
+
+  const DamageClusters clusters = find_damage_clusters(px, pz, damaged, r.link_distance_m);
+  m.cluster_count = clusters.count;
+  std::vector<ClusterTally> tally(clusters.count);
+  for (std::size_t p = 0; p < px.size(); ++p) {
+    const auto c = clusters.label[p];
+    if (c == DamageClusters::kNone) continue;
+    ClusterTally& t = tally[static_cast<std::size_t>(c)];
+    ++t.particle_count;
+    t.z_min = std::min(t.z_min, pz[p]);
+    // The top of the particle's volume within reach of the material surface.
+    if (pz[p] + half_spacing >= m.surface.height_at(px[p]) - r.surface_reach_m) {
+      ++t.surface_count;
+      t.surface_x_sum += px[p];
+      t.surface_x_min = std::min(t.surface_x_min, px[p]);
+      t.surface_x_max = std::max(t.surface_x_max, px[p]);
+    }
+  }
+
+  std::vector<Candidate> candidates;
+  for (const ClusterTally& t : tally) {
+    if (t.surface_count == 0) continue;  // buried damage is not a crevasse
+    Candidate c;
+    c.crevasse.x_m = t.surface_x_sum / static_cast<double>(t.surface_count);
+    if (!window_has_length || !in_window(c.crevasse.x_m)) continue;
+    c.left_m = t.surface_x_min - half_spacing;
+    c.right_m = t.surface_x_max + half_spacing;
+    // Local surface from the intact lips either side, so that neither an opening too wide to
+    // be bridged nor a sloping or curved surface biases the depth.
+    const double x_left_lip = c.left_m - r.lip_offset_m, x_right_lip = c.right_m + r.lip_offset_m;
+    const double t_lip = (c.crevasse.x_m - x_left_lip) / (x_right_lip - x_left_lip);
+    c.crevasse.surface_z_m = (1.0 - t_lip) * m.surface.height_at(x_left_lip) +
+                             t_lip * m.surface.height_at(x_right_lip);
+    c.crevasse.bottom_z_m = t.z_min - half_spacing;
+    c.crevasse.depth_m = std::max(0.0, c.crevasse.surface_z_m - c.crevasse.bottom_z_m);
+    c.crevasse.particle_count = t.particle_count;
+    c.crevasse.width_m = c.right_m - c.left_m;
+    candidates.push_back(c);
+  }
+  std::sort(candidates.begin(), candidates.end(),
+            [](const Candidate& a, const Candidate& b) { return a.crevasse.x_m < b.crevasse.x_m; });
+
+  // Closer than the floor: one feature. It keeps the deeper one's position and depth, the
+  // union of their widths; the spacing between them is dropped and counted.
+  std::vector<Candidate> kept;
+  for (const Candidate& c : candidates) {
+    if (!kept.empty() && c.crevasse.x_m - kept.back().crevasse.x_m < r.resolution_floor_m) {
+      Candidate& k = kept.back();
+      const std::size_t particles = k.crevasse.particle_count + c.crevasse.particle_count;
+      const std::size_t merged = k.crevasse.merged_count + c.crevasse.merged_count;
+      const double left = std::min(k.left_m, c.left_m), right = std::max(k.right_m, c.right_m);
+      if (c.crevasse.depth_m > k.crevasse.depth_m) k = c;
+      k.left_m = left;
+      k.right_m = right;
+      k.crevasse.width_m = right - left;
+      k.crevasse.particle_count = particles;
+      k.crevasse.merged_count = merged;
+      ++m.dropped_spacing_count;
+    } else {
+      kept.push_back(c);
+    }
+  }
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    if (i + 1 < kept.size()) {
+      const double s = kept[i + 1].crevasse.x_m - kept[i].crevasse.x_m;
+      kept[i].crevasse.spacing_to_next_m = s;
+      m.spacings_m.push_back(s);
+    }
+    m.crevasses.push_back(kept[i].crevasse);
+  }
+
+  m.flags.no_crevasse = m.crevasses.empty();
+  m.flags.has_spacing = !m.spacings_m.empty();
+  const double inv_h = 1.0 / r.ice_thickness_m;
+  if (m.flags.has_spacing) {
+    m.spacing_m = quartiles(m.spacings_m);
+    m.spacing_over_h = scaled(*m.spacing_m, inv_h);
+  }
+  if (!m.crevasses.empty()) {
+    std::vector<double> depths;
+    for (const Crevasse& c : m.crevasses) depths.push_back(c.depth_m);
+    m.depth_m = quartiles(depths);
+    m.depth_over_h = scaled(*m.depth_m, inv_h);
+  }
+  return m;
+}
+
+}  // namespace crevasse::analysis

@@ -1,0 +1,131 @@
+#pragma once
+// Crevasse positions, depths and spacings from a particle snapshot (SPEC §5,
+// research_physics.md §4). Definitions and the reasons for each default: docs/measurement.md.
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+#include "analysis/surface_profile.hpp"
+#include "engine/snapshot.hpp"
+
+namespace crevasse::analysis {
+
+// Every length default is a multiple of dx, H_i or the particle spacing, so that a setting means
+// the same thing at every resolution and thickness. Optional fields override the snapshot.
+struct MeasureSettings {
+  // Damaged ⇔ 1 − exp(−ζ ε_v^p) ≥ damage_threshold (SPEC §5); tied to strength loss, so it
+  // stays consistent when ζ is scaled with dx.
+  double damage_threshold = 0.95;
+  // Used instead when the snapshot has no softening (ζ = 0): damaged ⇔ ε_v^p ≥ this.
+  double eps_v_p_threshold = 0.01;
+
+  // Window along flow: [step_foot_x + margin·H_i, front − margin·H_i] unless given. The margins
+  // keep out the step's own bending zone and the front, whose free face cracks differently.
+  std::optional<double> window_min_x_m;
+  std::optional<double> window_max_x_m;
+  double window_margin_over_h = 0.5;
+
+  // Neighbouring crevasses closer than this are one feature at this resolution: merged, and
+  // the spacing between them is dropped and counted (SPEC §5).
+  double resolution_floor_over_dx = 3.0;
+  // Damaged particles closer than this belong to one crevasse; 1.5 spacings links axial and
+  // diagonal lattice neighbours but not particles across a one-particle intact gap.
+  double link_distance_over_spacing = 1.5;
+  // A damaged cluster is a crevasse when one of its particles comes this close to z_s(x).
+  double surface_reach_over_dx = 1.5;
+  // Surface profile: moving average over this many dx-bins (odd; 1 = none), and dips narrower
+  // than 2 × bridge half-width (crevasse openings) bridged between their lips. The bridge also
+  // lifts a concave bend of the surface by about (change of slope) × half-width / 2, so it is
+  // kept short: 0.25·H_i (never below dx).
+  int surface_smoothing_bins = 3;
+  double surface_bridge_half_width_over_h = 0.25;
+
+  // "fragmented" when at least this fraction of the particles in the window is damaged, or
+  // when more than this fraction of the window's surface bins has no undamaged particle.
+  double fragmented_fraction = 0.5;
+
+  // 3D: only particles with |y − y_c| ≤ band/2 are measured, y_c the middle of the particles'
+  // y-range unless given. Two cells hold enough particles to link a crevasse across the band.
+  double y_band_width_over_dx = 2.0;
+  std::optional<double> y_band_center_m;
+
+  std::optional<double> dx_m;                // bin width; default snapshot.dx_m
+  std::optional<double> ice_thickness_m;     // H_i; default snapshot.ice_thickness_m
+  std::optional<double> particle_spacing_m;  // default snapshot value, else dx/2
+};
+
+// The numbers actually used, recorded with every result.
+struct ResolvedMeasureSettings {
+  double damage_threshold = 0.0;
+  double eps_v_p_threshold = 0.0;       // the ε_v^p at which a particle becomes damaged
+  bool threshold_from_softening = false;  // false: the absolute ε_v^p threshold was used
+  double window_min_x_m = 0.0;
+  double window_max_x_m = 0.0;
+  bool window_explicit = false;
+  double dx_m = 0.0;
+  double ice_thickness_m = 0.0;
+  double particle_spacing_m = 0.0;
+  double resolution_floor_m = 0.0;
+  double link_distance_m = 0.0;
+  double surface_reach_m = 0.0;
+  int surface_smoothing_bins = 0;
+  double surface_bridge_half_width_m = 0.0;
+  // The lips are read this far outside a crevasse's damaged material: far enough that the
+  // smoothing window does not reach into the crevasse, (smoothing_bins/2 + 1)·dx.
+  double lip_offset_m = 0.0;
+  double fragmented_fraction = 0.0;
+  int dim = 2;
+  double y_band_center_m = 0.0;  // 3D only
+  double y_band_width_m = 0.0;   // 3D only
+};
+
+struct Crevasse {
+  double x_m = 0.0;          // where it meets the surface: mean x of its members near z_s
+  double surface_z_m = 0.0;  // local surface at x_m: interpolated between the two lips
+  double bottom_z_m = 0.0;   // lowest damaged material (lowest centre − half a spacing)
+  double depth_m = 0.0;      // surface_z_m − bottom_z_m
+  double width_m = 0.0;      // x-extent of its damaged material near the surface
+  std::size_t particle_count = 0;
+  std::size_t merged_count = 1;              // clusters merged into it by the resolution floor
+  std::optional<double> spacing_to_next_m;  // absent for the most downstream crevasse
+};
+
+struct QuartileSummary {
+  double q25 = 0.0;
+  double median = 0.0;
+  double q75 = 0.0;
+};
+
+struct MeasureFlags {
+  bool empty_snapshot = false;  // no particles (in the 3D band) at all
+  bool empty_window = false;    // window of zero length or holding no particles
+  bool no_crevasse = false;     // no crevasse inside the window
+  bool fragmented = false;      // see MeasureSettings::fragmented_fraction
+  bool has_spacing = false;     // at least one spacing survived the floor
+};
+
+struct CrevasseMeasurement {
+  ResolvedMeasureSettings settings;
+  double time_s = 0.0;
+  std::vector<Crevasse> crevasses;  // inside the window, sorted by x, after merging
+  std::vector<double> spacings_m;   // between consecutive crevasses, all ≥ the floor
+  std::size_t dropped_spacing_count = 0;
+  std::size_t particle_count = 0;          // particles measured (the band, in 3D)
+  std::size_t window_particle_count = 0;
+  std::size_t damaged_particle_count = 0;  // of the measured particles
+  std::size_t cluster_count = 0;           // damaged clusters anywhere, crevasse or not
+  // Statistics are absent (not NaN) when there is nothing to summarise.
+  std::optional<QuartileSummary> spacing_m, spacing_over_h;
+  std::optional<QuartileSummary> depth_m, depth_over_h;
+  MeasureFlags flags;
+  SurfaceProfile surface;
+};
+
+// Throws std::invalid_argument with the offending field when the snapshot's arrays disagree in
+// length, hold non-finite positions, or dx / H_i are unknown while particles are present.
+ResolvedMeasureSettings resolve_measure_settings(const ParticleSnapshot& snapshot,
+                                                 const MeasureSettings& settings);
+CrevasseMeasurement measure_crevasses(const ParticleSnapshot& snapshot,
+                                      const MeasureSettings& settings = {});
+
+}  // namespace crevasse::analysis

@@ -1,0 +1,122 @@
+#include "analysis/measurement_io.hpp"
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+
+namespace crevasse::analysis {
+
+namespace {
+
+std::ofstream open_for_writing(const std::filesystem::path& path, const char* what) {
+  std::ofstream out(path);
+  if (!out) {
+    throw std::runtime_error(std::string("cannot write ") + what + " to '" + path.string() +
+                             "': " + std::strerror(errno) + " (does the directory exist?)");
+  }
+  // 10 significant digits: sub-millimetre at glacier scales, and stable across platforms.
+  out.precision(10);
+  return out;
+}
+
+void finish(std::ofstream& out, const std::filesystem::path& path, const char* what) {
+  out.flush();
+  if (!out) {
+    throw std::runtime_error(std::string("writing ") + what + " to '" + path.string() +
+                             "' failed (disk full?)");
+  }
+}
+
+nlohmann::json quartiles_json(const std::optional<QuartileSummary>& q) {
+  if (!q) return nullptr;
+  return {{"q25", q->q25}, {"median", q->median}, {"q75", q->q75}};
+}
+
+}  // namespace
+
+void write_crevasses_csv(const CrevasseMeasurement& m, const std::filesystem::path& path) {
+  std::ofstream out = open_for_writing(path, "crevasses CSV");
+  out << "index,x_m,depth_m,width_m,depth_over_H,spacing_to_next_m\n";
+  const double h = m.settings.ice_thickness_m;
+  for (std::size_t i = 0; i < m.crevasses.size(); ++i) {
+    const Crevasse& c = m.crevasses[i];
+    out << i << ',' << c.x_m << ',' << c.depth_m << ',' << c.width_m << ','
+        << (h > 0.0 ? c.depth_m / h : 0.0) << ',';
+    if (c.spacing_to_next_m) out << *c.spacing_to_next_m;
+    out << '\n';
+  }
+  finish(out, path, "crevasses CSV");
+}
+
+nlohmann::json settings_to_json(const ResolvedMeasureSettings& s) {
+  nlohmann::json j = {
+      {"damage_threshold", s.damage_threshold},
+      {"eps_v_p_threshold", s.eps_v_p_threshold},
+      {"threshold_from_softening", s.threshold_from_softening},
+      {"window_min_x_m", s.window_min_x_m},
+      {"window_max_x_m", s.window_max_x_m},
+      {"window_explicit", s.window_explicit},
+      {"dx_m", s.dx_m},
+      {"ice_thickness_m", s.ice_thickness_m},
+      {"particle_spacing_m", s.particle_spacing_m},
+      {"resolution_floor_m", s.resolution_floor_m},
+      {"link_distance_m", s.link_distance_m},
+      {"surface_reach_m", s.surface_reach_m},
+      {"surface_smoothing_bins", s.surface_smoothing_bins},
+      {"surface_bridge_half_width_m", s.surface_bridge_half_width_m},
+      {"lip_offset_m", s.lip_offset_m},
+      {"fragmented_fraction", s.fragmented_fraction},
+      {"dim", s.dim},
+  };
+  if (s.dim == 3) {
+    j["y_band_center_m"] = s.y_band_center_m;
+    j["y_band_width_m"] = s.y_band_width_m;
+  }
+  return j;
+}
+
+nlohmann::json measurement_summary_json(const CrevasseMeasurement& m) {
+  nlohmann::json positions = nlohmann::json::array(), depths = nlohmann::json::array(),
+                 widths = nlohmann::json::array();
+  for (const Crevasse& c : m.crevasses) {
+    positions.push_back(c.x_m);
+    depths.push_back(c.depth_m);
+    widths.push_back(c.width_m);
+  }
+  return {
+      {"time_s", m.time_s},
+      {"crevasse_count", m.crevasses.size()},
+      {"dropped_spacing_count", m.dropped_spacing_count},
+      {"spacing_count", m.spacings_m.size()},
+      {"spacing_m", quartiles_json(m.spacing_m)},
+      {"spacing_over_h", quartiles_json(m.spacing_over_h)},
+      {"depth_m", quartiles_json(m.depth_m)},
+      {"depth_over_h", quartiles_json(m.depth_over_h)},
+      {"flags",
+       {{"empty_snapshot", m.flags.empty_snapshot},
+        {"empty_window", m.flags.empty_window},
+        {"no_crevasse", m.flags.no_crevasse},
+        {"fragmented", m.flags.fragmented},
+        {"has_spacing", m.flags.has_spacing}}},
+      {"counts",
+       {{"particles", m.particle_count},
+        {"window_particles", m.window_particle_count},
+        {"damaged_particles", m.damaged_particle_count},
+        {"damage_clusters", m.cluster_count}}},
+      {"positions_m", positions},
+      {"depths_m", depths},
+      {"widths_m", widths},
+      {"spacings_m", m.spacings_m},
+      {"settings", settings_to_json(m.settings)},
+  };
+}
+
+void write_measurement_summary(const CrevasseMeasurement& m, const std::filesystem::path& path) {
+  std::ofstream out = open_for_writing(path, "measurement summary JSON");
+  out << measurement_summary_json(m).dump(2) << '\n';
+  finish(out, path, "measurement summary JSON");
+}
+
+}  // namespace crevasse::analysis

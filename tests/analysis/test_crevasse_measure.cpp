@@ -1,0 +1,384 @@
+// Crevasse measurement on synthetic slabs whose crevasses are known exactly (SPEC §5).
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "analysis/crevasse_measure.hpp"
+#include "analysis/measurement_io.hpp"
+#include "synthetic_slab.hpp"
+
+namespace crevasse::analysis {
+namespace {
+
+using test::make_slab;
+using test::Notch;
+using test::SlabSpec;
+
+// Notches every `spacing` metres from x_min + H_i to x_max − H_i (inside the default window),
+// with depths cycling through `depths`.
+std::vector<Notch> notch_train(const SlabSpec& spec, double spacing, std::vector<double> depths) {
+  std::vector<Notch> notches;
+  std::size_t k = 0;
+  for (double x = spec.x_min_m + spec.thickness_m + 0.3 * spec.dx_m;
+       x <= spec.x_max_m - spec.thickness_m; x += spacing, ++k) {
+    notches.push_back({.x_m = x, .depth_m = depths[k % depths.size()]});
+  }
+  return notches;
+}
+
+// Every number in a JSON document is finite (nlohmann writes NaN as null, so also no nulls
+// outside the documented optional statistics).
+void expect_all_finite(const nlohmann::json& j) {
+  if (j.is_number()) {
+    EXPECT_TRUE(std::isfinite(j.get<double>()));
+  } else if (j.is_structured()) {
+    for (const auto& v : j) expect_all_finite(v);
+  }
+}
+
+void expect_measurement_finite(const CrevasseMeasurement& m) {
+  expect_all_finite(measurement_summary_json(m));
+  for (double z : m.surface.z_m) EXPECT_TRUE(std::isfinite(z));
+}
+
+void expect_matches(const CrevasseMeasurement& m, const std::vector<Notch>& notches, double tol) {
+  ASSERT_EQ(m.crevasses.size(), notches.size());
+  for (std::size_t i = 0; i < notches.size(); ++i) {
+    EXPECT_NEAR(m.crevasses[i].x_m, notches[i].x_m, tol) << "crevasse " << i;
+    EXPECT_NEAR(m.crevasses[i].depth_m, notches[i].depth_m, tol) << "crevasse " << i;
+  }
+}
+
+struct SpacingCase {
+  double spacing_m;
+  double thickness_m;
+};
+
+class MeasureSpacing : public ::testing::TestWithParam<SpacingCase> {};
+
+TEST_P(MeasureSpacing, RecoversPositionsDepthsAndSpacingUnderNoise) {
+  const auto [spacing, thickness] = GetParam();
+  SlabSpec spec{.thickness_m = thickness, .x_max_m = 2500.0, .noise_over_spacing = 0.2};
+  // Depths are whole particle layers (multiples of dx/2) so the truth is exact on the lattice.
+  const auto notches = notch_train(spec, spacing, {0.3 * thickness, 0.5 * thickness, 40.0});
+  const CrevasseMeasurement m = measure_crevasses(make_slab(spec, notches));
+
+  // One cell: the lattice puts a notch up to half a spacing from its nominal x, the ±20% noise
+  // moves particles by up to 0.2 spacings, and the surface is resolved on dx-bins.
+  const double tol = spec.dx_m;
+  expect_matches(m, notches, tol);
+  EXPECT_EQ(m.dropped_spacing_count, 0u);
+  ASSERT_TRUE(m.flags.has_spacing);
+  ASSERT_TRUE(m.spacing_m.has_value());
+  EXPECT_NEAR(m.spacing_m->median, spacing, tol);
+  EXPECT_NEAR(m.spacing_over_h->median, spacing / thickness, tol / thickness);
+  EXPECT_EQ(m.spacings_m.size(), notches.size() - 1);
+  EXPECT_FALSE(m.flags.fragmented);
+  EXPECT_FALSE(m.flags.no_crevasse);
+  expect_measurement_finite(m);
+}
+
+INSTANTIATE_TEST_SUITE_P(Synthetic, MeasureSpacing,
+                         ::testing::Values(SpacingCase{40.0, 100.0}, SpacingCase{60.0, 200.0},
+                                           SpacingCase{100.0, 300.0}, SpacingCase{60.0, 100.0}));
+
+TEST(MeasureQuartiles, FollowLinearInterpolationBetweenOrderStatistics) {
+  SlabSpec spec{.thickness_m = 100.0, .x_max_m = 1000.0};
+  // Spacings 40, 60, 80, 100 m: type-7 quartiles 55, 70, 85 m.
+  std::vector<Notch> notches;
+  double x = 150.0;
+  for (double s : {40.0, 60.0, 80.0, 100.0, 0.0}) {
+    notches.push_back({.x_m = x + 1.0, .depth_m = 30.0});
+    x += s;
+  }
+  const CrevasseMeasurement m = measure_crevasses(make_slab(spec, notches));
+  ASSERT_TRUE(m.spacing_m.has_value());
+  // Exact lattice, no noise: positions are column centres, identical offsets cancel.
+  EXPECT_NEAR(m.spacing_m->q25, 55.0, 1e-9);
+  EXPECT_NEAR(m.spacing_m->median, 70.0, 1e-9);
+  EXPECT_NEAR(m.spacing_m->q75, 85.0, 1e-9);
+  EXPECT_NEAR(m.depth_m->median, 30.0, 1e-9);
+  EXPECT_NEAR(m.depth_over_h->median, 0.3, 1e-9);
+}
+
+TEST(MeasureIntact, SlabWithoutDamageHasNoCrevasse) {
+  const CrevasseMeasurement m = measure_crevasses(make_slab({.noise_over_spacing = 0.2}, {}));
+  EXPECT_TRUE(m.crevasses.empty());
+  EXPECT_TRUE(m.flags.no_crevasse);
+  EXPECT_FALSE(m.flags.has_spacing);
+  EXPECT_FALSE(m.spacing_m.has_value());
+  EXPECT_FALSE(m.depth_m.has_value());
+  EXPECT_FALSE(m.flags.fragmented);
+  EXPECT_FALSE(m.flags.empty_window);
+  EXPECT_EQ(m.cluster_count, 0u);
+  expect_measurement_finite(m);
+}
+
+TEST(MeasureBuried, DamageThatDoesNotReachTheSurfaceIsNotACrevasse) {
+  SlabSpec spec;
+  // Buried 30 m below the surface: beyond the 1.5·dx = 15 m reach.
+  const std::vector<Notch> notches = {{.x_m = 500.0, .depth_m = 80.0, .width_m = 20.0, .top_gap_m = 30.0},
+                                      {.x_m = 900.0, .depth_m = 50.0}};
+  const CrevasseMeasurement m = measure_crevasses(make_slab(spec, notches));
+  EXPECT_EQ(m.cluster_count, 2u);
+  ASSERT_EQ(m.crevasses.size(), 1u);
+  // One cell: lattice placement of the notch column.
+  EXPECT_NEAR(m.crevasses[0].x_m, 900.0, spec.dx_m);
+  EXPECT_NEAR(m.crevasses[0].depth_m, 50.0, spec.dx_m);
+}
+
+TEST(MeasureFloor, NotchesCloserThanTheFloorCountAsOne) {
+  SlabSpec spec;
+  // 20 m < 3·dx = 30 m apart: one feature at this resolution, keeping the deeper one.
+  const std::vector<Notch> notches = {{.x_m = 300.0, .depth_m = 30.0},
+                                      {.x_m = 400.0, .depth_m = 30.0},
+                                      {.x_m = 420.0, .depth_m = 50.0},
+                                      {.x_m = 520.0, .depth_m = 30.0}};
+  const CrevasseMeasurement m = measure_crevasses(make_slab(spec, notches));
+  ASSERT_EQ(m.crevasses.size(), 3u);
+  EXPECT_EQ(m.dropped_spacing_count, 1u);
+  EXPECT_EQ(m.spacings_m.size(), 2u);
+  EXPECT_EQ(m.crevasses[1].merged_count, 2u);
+  // One cell: lattice placement.
+  EXPECT_NEAR(m.crevasses[1].x_m, 420.0, spec.dx_m);
+  EXPECT_NEAR(m.crevasses[1].depth_m, 50.0, spec.dx_m);
+  // The merged width spans both notches: 20 m apart plus one column.
+  EXPECT_NEAR(m.crevasses[1].width_m, 25.0, spec.dx_m);
+  for (double s : m.spacings_m) EXPECT_GE(s, m.settings.resolution_floor_m);
+}
+
+TEST(MeasureSlope, DepthIsRelativeToTheLocalSurfaceOnASlope) {
+  // The surface drops 200 m over the slab (slope 0.1): a global surface height would be wrong
+  // by up to 200 m.
+  SlabSpec spec{.x_max_m = 2000.0, .noise_over_spacing = 0.2};
+  spec.base_z = [](double x) { return -0.1 * x; };
+  const auto notches = notch_train(spec, 80.0, {30.0, 60.0});
+  const CrevasseMeasurement m = measure_crevasses(make_slab(spec, notches));
+  // One cell: lattice placement and noise; on a slope a dx-bin also spans 1 m of height.
+  expect_matches(m, notches, spec.dx_m);
+  expect_measurement_finite(m);
+}
+
+TEST(MeasureCurved, DepthIsRelativeToTheLocalSurfaceOnACurvedSurface) {
+  // Ice draped over a smooth 80 m step: surface height changes by tens of metres along x,
+  // with both convex and concave bends.
+  SlabSpec spec{.thickness_m = 150.0, .x_max_m = 2500.0, .noise_over_spacing = 0.2};
+  spec.base_z = [](double x) { return -40.0 * std::tanh((x - 1200.0) / 200.0); };
+  const auto notches = notch_train(spec, 60.0, {40.0, 75.0, 20.0});
+  const CrevasseMeasurement m = measure_crevasses(make_slab(spec, notches));
+  // One cell, as above; the bridge and the lips add < 1 m on these curvatures.
+  expect_matches(m, notches, spec.dx_m);
+  expect_measurement_finite(m);
+}
+
+TEST(MeasureCurved, DepthFollowsTheSurfaceOfIceDraggedOverARamp) {
+  // Piecewise-linear draping: plateau, ramp of slope 0.3, floor (sharp bends).
+  SlabSpec spec{.x_max_m = 2000.0, .noise_over_spacing = 0.1};
+  spec.base_z = [](double x) { return x < 600.0 ? 90.0 : (x < 900.0 ? 90.0 - 0.3 * (x - 600.0) : 0.0); };
+  const auto notches = notch_train(spec, 70.0, {30.0, 50.0});
+  const CrevasseMeasurement m = measure_crevasses(make_slab(spec, notches));
+  // One cell. At the concave bend the bridge can lift the lips by up to slope change ×
+  // half-width / 2 = 0.3 × 25 m / 2 ≈ 4 m, inside that cell.
+  expect_matches(m, notches, spec.dx_m);
+}
+
+TEST(MeasureFragmented, FullyDamagedSlabIsFlaggedAndFinite) {
+  SlabSpec spec{.x_max_m = 1000.0};
+  const CrevasseMeasurement m = measure_crevasses(
+      make_slab(spec, {{.x_m = 500.0, .depth_m = spec.thickness_m, .width_m = 2000.0}}));
+  EXPECT_TRUE(m.flags.fragmented);
+  EXPECT_EQ(m.damaged_particle_count, m.particle_count);
+  EXPECT_FALSE(m.flags.has_spacing);
+  EXPECT_LE(m.crevasses.size(), 1u);
+  expect_measurement_finite(m);
+}
+
+TEST(MeasureFragmented, MostlyDamagedWindowIsFlagged) {
+  SlabSpec spec{.x_max_m = 1000.0};
+  // Damaged columns 15 m wide every 20 m: three quarters of the ice is broken.
+  std::vector<Notch> notches;
+  for (double x = 100.0; x < 1000.0; x += 20.0) notches.push_back({.x_m = x, .depth_m = 100.0, .width_m = 15.0});
+  const CrevasseMeasurement m = measure_crevasses(make_slab(spec, notches));
+  EXPECT_TRUE(m.flags.fragmented);
+  expect_measurement_finite(m);
+}
+
+TEST(MeasureWindow, EmptyWindowIsFlaggedNotAnError) {
+  const auto slab = make_slab({}, {{.x_m = 500.0, .depth_m = 30.0}});
+  MeasureSettings inverted;
+  inverted.window_min_x_m = 800.0;
+  inverted.window_max_x_m = 700.0;
+  const CrevasseMeasurement a = measure_crevasses(slab, inverted);
+  EXPECT_TRUE(a.flags.empty_window);
+  EXPECT_TRUE(a.flags.no_crevasse);
+  EXPECT_TRUE(a.crevasses.empty());
+  expect_measurement_finite(a);
+
+  MeasureSettings beyond_front;  // the front has not yet travelled past the window
+  beyond_front.window_min_x_m = 5000.0;
+  beyond_front.window_max_x_m = 6000.0;
+  const CrevasseMeasurement b = measure_crevasses(slab, beyond_front);
+  EXPECT_TRUE(b.flags.empty_window);
+  EXPECT_EQ(b.window_particle_count, 0u);
+  expect_measurement_finite(b);
+}
+
+TEST(MeasureWindow, DefaultWindowExcludesStepAndFrontZones) {
+  SlabSpec spec{.x_max_m = 1000.0};
+  // 30 m past the step foot and 20 m before the front: both inside the 0.5·H_i margins.
+  const std::vector<Notch> notches = {{.x_m = 30.0, .depth_m = 30.0},
+                                      {.x_m = 500.0, .depth_m = 30.0},
+                                      {.x_m = 980.0, .depth_m = 30.0}};
+  const CrevasseMeasurement m = measure_crevasses(make_slab(spec, notches));
+  EXPECT_DOUBLE_EQ(m.settings.window_min_x_m, 50.0);
+  EXPECT_DOUBLE_EQ(m.settings.window_max_x_m, 997.5 - 50.0);  // front = last column centre
+  ASSERT_EQ(m.crevasses.size(), 1u);
+  EXPECT_FALSE(m.flags.has_spacing);
+}
+
+TEST(MeasureEmpty, EmptySnapshotGivesDefinedResult) {
+  const CrevasseMeasurement m = measure_crevasses(ParticleSnapshot{});
+  EXPECT_TRUE(m.flags.empty_snapshot);
+  EXPECT_TRUE(m.flags.empty_window);
+  EXPECT_TRUE(m.flags.no_crevasse);
+  EXPECT_TRUE(m.crevasses.empty());
+  expect_measurement_finite(m);
+}
+
+TEST(MeasureInvalid, InconsistentSnapshotThrowsWithTheField) {
+  auto slab = make_slab({.x_max_m = 500.0}, {});
+  slab.eps_v_p.pop_back();
+  try {
+    measure_crevasses(slab);
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("eps_v_p"), std::string::npos) << e.what();
+  }
+  auto no_dx = make_slab({.x_max_m = 500.0}, {});
+  no_dx.dx_m = 0.0;
+  EXPECT_THROW(measure_crevasses(no_dx), std::invalid_argument);
+  MeasureSettings override_dx;
+  override_dx.dx_m = 10.0;
+  EXPECT_NO_THROW(measure_crevasses(no_dx, override_dx));
+}
+
+TEST(MeasureThreshold, WithoutSofteningTheAbsoluteThresholdApplies) {
+  SlabSpec spec{.softening_zeta = 0.0, .notch_eps_v_p = 0.02};
+  const std::vector<Notch> notches = {{.x_m = 400.0, .depth_m = 40.0}, {.x_m = 600.0, .depth_m = 40.0}};
+  const auto slab = make_slab(spec, notches);
+  const CrevasseMeasurement m = measure_crevasses(slab);  // default threshold 0.01 < 0.02
+  EXPECT_EQ(m.crevasses.size(), 2u);
+  EXPECT_FALSE(m.settings.threshold_from_softening);
+  MeasureSettings strict;
+  strict.eps_v_p_threshold = 0.05;
+  EXPECT_TRUE(measure_crevasses(slab, strict).flags.no_crevasse);
+}
+
+TEST(MeasureThreshold, SoftenedThresholdIsThreeOverZeta) {
+  // 1 − exp(−ζ ε) = 0.95 ⇔ ε = ln(20)/ζ ≈ 3/ζ: just below is intact, just above damaged.
+  const double eps_threshold = std::log(20.0) / 500.0;
+  SlabSpec below{.notch_eps_v_p = 0.99 * eps_threshold};
+  SlabSpec above{.notch_eps_v_p = 1.01 * eps_threshold};
+  const std::vector<Notch> notch = {{.x_m = 500.0, .depth_m = 40.0}};
+  EXPECT_TRUE(measure_crevasses(make_slab(below, notch)).flags.no_crevasse);
+  EXPECT_EQ(measure_crevasses(make_slab(above, notch)).crevasses.size(), 1u);
+}
+
+TEST(Measure3D, CentralBandGivesTheSameCrevasses) {
+  SlabSpec spec{.dim = 3, .x_max_m = 1000.0, .width_m = 60.0, .noise_over_spacing = 0.2};
+  const auto notches = notch_train(spec, 60.0, {30.0, 50.0});
+  const CrevasseMeasurement m = measure_crevasses(make_slab(spec, notches));
+  EXPECT_EQ(m.settings.dim, 3);
+  EXPECT_NEAR(m.settings.y_band_center_m, 30.0, 1.0);  // middle of [0, 60] m up to the noise
+  EXPECT_LT(m.particle_count, make_slab(spec, notches).size());
+  // One cell, as in 2D.
+  expect_matches(m, notches, spec.dx_m);
+  expect_measurement_finite(m);
+}
+
+TEST(MeasurePerformance, MillionParticlesMeasureQuickly) {
+  // 12.5 km × 125 m at 1.25 m particle spacing: 10^6 particles.
+  SlabSpec spec{.dx_m = 2.5, .thickness_m = 125.0, .x_max_m = 12500.0, .noise_over_spacing = 0.2};
+  const auto notches = notch_train(spec, 50.0, {30.0, 60.0});
+  const auto slab = make_slab(spec, notches);
+  ASSERT_GE(slab.size(), 1'000'000u);
+  const auto start = std::chrono::steady_clock::now();
+  const CrevasseMeasurement m = measure_crevasses(slab);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(m.crevasses.size(), notches.size());
+  // Generous: about 0.3 s in a Release build on one core; the bound only catches an
+  // accidental O(N²) (which would take minutes), not ordinary machine variance.
+  EXPECT_LT(seconds, 5.0);
+}
+
+TEST(MeasureWriters, CsvAndJsonAreParseable) {
+  SlabSpec spec{.x_max_m = 1000.0};
+  const auto notches = notch_train(spec, 100.0, {30.0});
+  const CrevasseMeasurement m = measure_crevasses(make_slab(spec, notches));
+  const auto dir = std::filesystem::temp_directory_path() / "crevasse_measure_writers";
+  std::filesystem::create_directories(dir);
+  write_crevasses_csv(m, dir / "crevasses.csv");
+  write_measurement_summary(m, dir / "summary.json");
+
+  std::ifstream csv(dir / "crevasses.csv");
+  std::string line;
+  ASSERT_TRUE(std::getline(csv, line));
+  EXPECT_EQ(line, "index,x_m,depth_m,width_m,depth_over_H,spacing_to_next_m");
+  std::size_t rows = 0;
+  while (std::getline(csv, line)) {
+    std::vector<std::string> fields;
+    std::stringstream ss(line);
+    std::string f;
+    while (std::getline(ss, f, ',')) fields.push_back(f);
+    if (!line.empty() && line.back() == ',') fields.push_back("");
+    ASSERT_EQ(fields.size(), 6u) << line;
+    EXPECT_EQ(std::stoul(fields[0]), rows);
+    EXPECT_NEAR(std::stod(fields[1]), m.crevasses[rows].x_m, 1e-6);
+    EXPECT_NEAR(std::stod(fields[4]), m.crevasses[rows].depth_m / 100.0, 1e-9);
+    const bool last = rows + 1 == m.crevasses.size();
+    EXPECT_EQ(fields[5].empty(), last) << line;
+    EXPECT_EQ(line.find("nan"), std::string::npos);
+    ++rows;
+  }
+  EXPECT_EQ(rows, m.crevasses.size());
+
+  std::ifstream js(dir / "summary.json");
+  const nlohmann::json j = nlohmann::json::parse(js);
+  EXPECT_EQ(j["crevasse_count"].get<std::size_t>(), m.crevasses.size());
+  EXPECT_EQ(j["dropped_spacing_count"].get<std::size_t>(), 0u);
+  EXPECT_NEAR(j["spacing_m"]["median"].get<double>(), 100.0, 1e-9);
+  EXPECT_NEAR(j["spacing_over_h"]["median"].get<double>(), 1.0, 1e-9);
+  EXPECT_TRUE(j["flags"]["has_spacing"].get<bool>());
+  EXPECT_DOUBLE_EQ(j["settings"]["damage_threshold"].get<double>(), 0.95);
+  EXPECT_DOUBLE_EQ(j["settings"]["resolution_floor_m"].get<double>(), 30.0);
+  EXPECT_EQ(j["positions_m"].size(), m.crevasses.size());
+  expect_all_finite(j);
+
+  // No crevasse: statistics are null, never NaN, and the flags say why.
+  const nlohmann::json none = measurement_summary_json(measure_crevasses(make_slab(spec, {})));
+  EXPECT_TRUE(none["spacing_m"].is_null());
+  EXPECT_TRUE(none["flags"]["no_crevasse"].get<bool>());
+  EXPECT_FALSE(none["flags"]["has_spacing"].get<bool>());
+  std::filesystem::remove_all(dir);
+}
+
+TEST(MeasureWriters, UnwritablePathThrowsWithThePath) {
+  const CrevasseMeasurement m = measure_crevasses(ParticleSnapshot{});
+  try {
+    write_crevasses_csv(m, "/nonexistent-dir/crevasses.csv");
+    FAIL() << "expected std::runtime_error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent-dir/crevasses.csv"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace crevasse::analysis
