@@ -1,0 +1,87 @@
+#pragma once
+// Capped von Mises plasticity with a softening tensile cap (SPEC §3), returned in principal
+// Hencky strain space. With Hencky elasticity the volumetric and deviatoric parts decouple, so
+// the closest-point return onto {p ≥ p_c(ε_v^p), q ≤ q_y} is two independent clamps that
+// commute (research_physics.md §3.2):
+//  * cap:   shift tr ε by −Δ (Δ/d on each principal strain), ε_v^p += Δ, p → p_c(ε_v^p + Δ);
+//  * shear: scale dev ε radially so that q = q_y (isochoric: tr ε unchanged).
+#include <algorithm>
+#include <cmath>
+
+#include "engine/hencky.hpp"
+
+namespace crevasse {
+
+struct CappedVonMisesParams {
+  double tensile_strength_c = 0.0;  // c [Pa], p_c(0) = −c
+  double shear_strength_qy = 0.0;   // q_y [Pa]
+  double softening_zeta = 0.0;      // ζ [-]; 0 = perfectly plastic cap
+};
+
+template <int Dim>
+struct ReturnResult {
+  Vec<Dim> eps;            // returned principal Hencky strains
+  double delta_eps_v = 0;  // increment of ε_v^p (≥ 0)
+  bool cap_active = false;
+  bool shear_active = false;
+};
+
+// Tensile cap pressure p_c(ε_v^p) = −c·exp(−ζ ε_v^p).
+inline double cap_pressure(const CappedVonMisesParams& p, double eps_v_p) {
+  return -p.tensile_strength_c * std::exp(-p.softening_zeta * eps_v_p);
+}
+
+// Solves g(Δ) = p_tr + K Δ + c·exp(−ζ(ε_v + Δ)) = 0 for Δ > 0, given g(0) < 0.
+// g is increasing and convex while cζe^{−ζε} < K, so Newton from the right end of the bracket
+// [0, −p_tr/K] (where g > 0) converges monotonically; bisection guards the rare bad step.
+// Outside that range (ζ ≥ K/c: local snap-back, no unique root) the cap is taken explicitly
+// at the start-of-step ε_v^p, which is stable for any step size.
+inline double cap_return_increment(double p_trial, double bulk_k, double eps_v_p,
+                                   const CappedVonMisesParams& p) {
+  const double c = p.tensile_strength_c;
+  const double zeta = p.softening_zeta;
+  const double pc_now = cap_pressure(p, eps_v_p);
+  if (zeta <= 0.0 || c * zeta >= bulk_k) return (pc_now - p_trial) / bulk_k;
+  double lo = 0.0;
+  double hi = -p_trial / bulk_k;  // g(hi) = c·exp(..) > 0 because p_trial < 0
+  double d = hi;
+  for (int it = 0; it < 60; ++it) {
+    const double e = c * std::exp(-zeta * (eps_v_p + d));
+    const double g = p_trial + bulk_k * d + e;
+    if (g > 0.0) hi = d; else lo = d;
+    const double dg = bulk_k - zeta * e;
+    double next = d - g / dg;
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    if (std::abs(next - d) <= 1e-15 * std::max(1.0, std::abs(d)) + 1e-300) return next;
+    d = next;
+  }
+  return d;
+}
+
+template <int Dim>
+inline ReturnResult<Dim> return_map_capped_von_mises(const Vec<Dim>& eps_trial, double eps_v_p,
+                                                    const ElasticModuli& m,
+                                                    const CappedVonMisesParams& p) {
+  ReturnResult<Dim> r;
+  r.eps = eps_trial;
+  const double k = m.bulk(Dim);
+  const double tr = eps_trial.sum();
+  const double p_trial = -k * tr;
+  if (p_trial < cap_pressure(p, eps_v_p)) {
+    const double delta = cap_return_increment(p_trial, k, eps_v_p, p);
+    r.eps.array() -= delta / Dim;
+    r.delta_eps_v = delta;
+    r.cap_active = true;
+  }
+  const double tr_new = r.eps.sum();
+  Vec<Dim> dev = r.eps.array() - tr_new / Dim;
+  const double q_trial = std::sqrt(6.0) * m.mu * dev.norm();  // q = sqrt(3/2)·2μ‖dev ε‖
+  if (q_trial > p.shear_strength_qy) {
+    dev *= p.shear_strength_qy / q_trial;
+    r.eps = (dev.array() + tr_new / Dim).matrix();
+    r.shear_active = true;
+  }
+  return r;
+}
+
+}  // namespace crevasse

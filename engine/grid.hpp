@@ -1,0 +1,47 @@
+#pragma once
+// Dense background grid over a box of lattice nodes [lo, lo + n). Node (i, j[, k]) sits at
+// (i, j[, k])·dx. The box is re-fitted to the particles every step, so empty air and rock
+// cost nothing. Flattening is x-slowest, which keeps an x-slab of nodes contiguous.
+#include <vector>
+
+#include "engine/types.hpp"
+
+namespace crevasse {
+
+template <int Dim>
+struct Grid {
+  double dx = 1.0;
+  IVec<Dim> lo = IVec<Dim>::Zero();
+  IVec<Dim> n = IVec<Dim>::Zero();
+  std::vector<double> mass;
+  std::vector<Vec<Dim>> vel;  // momentum during P2G, velocity after the grid update
+
+  std::size_t node_count() const {
+    std::size_t c = 1;
+    for (int a = 0; a < Dim; ++a) c *= static_cast<std::size_t>(n[a]);
+    return c;
+  }
+  std::size_t flat(const IVec<Dim>& node) const {
+    std::size_t f = 0;
+    for (int a = 0; a < Dim; ++a) f = f * n[a] + static_cast<std::size_t>(node[a] - lo[a]);
+    return f;
+  }
+  IVec<Dim> node_of(std::size_t f) const {
+    IVec<Dim> node;
+    for (int a = Dim - 1; a >= 0; --a) {
+      node[a] = lo[a] + static_cast<int>(f % n[a]);
+      f /= n[a];
+    }
+    return node;
+  }
+  Vec<Dim> position(const IVec<Dim>& node) const { return node.template cast<double>() * dx; }
+
+  void reset(const IVec<Dim>& new_lo, const IVec<Dim>& new_n) {
+    lo = new_lo;
+    n = new_n;
+    mass.assign(node_count(), 0.0);
+    vel.assign(node_count(), Vec<Dim>::Zero());
+  }
+};
+
+}  // namespace crevasse

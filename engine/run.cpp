@@ -1,0 +1,97 @@
+#include "engine/run.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+#include "engine/error.hpp"
+#include "engine/simulation.hpp"
+
+namespace crevasse {
+namespace {
+
+template <int Dim>
+RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
+  Simulation<Dim> sim(scene);
+  RunSummary out;
+  out.initial_mass = sim.total_mass();
+  out.initial_particles = sim.particles().size();
+  const double front0 = sim.front_x();
+  const double target_front = scene.step_foot_x() + scene.front_past_step;
+
+  auto fraction = [&] {
+    double f = 0.0;
+    if (scene.end_time > 0) f = std::max(f, sim.time() / scene.end_time);
+    if (scene.front_past_step > 0 && target_front > front0)
+      f = std::max(f, (sim.front_x() - front0) / (target_front - front0));
+    if (scene.max_steps > 0) f = std::max(f, static_cast<double>(sim.steps()) / scene.max_steps);
+    return std::clamp(f, 0.0, 1.0);
+  };
+
+  int output_index = 0;
+  double next_output = 0.0;
+  auto maybe_output = [&] {
+    if (!obs || scene.vtu_interval <= 0) return;
+    if (sim.time() + 1e-12 >= next_output) {
+      obs->on_output(sim.snapshot(), output_index++);
+      next_output += scene.vtu_interval * std::max(1.0, std::floor((sim.time() - next_output) / scene.vtu_interval) + 1.0);
+    }
+  };
+  maybe_output();
+
+  double last_report = 0.0;
+  std::int64_t last_steps = 0, last_psteps = 0;
+  while (true) {
+    if (scene.end_time > 0 && sim.time() >= scene.end_time) { out.stop_reason = "end_time"; break; }
+    if (scene.front_past_step > 0 && sim.front_x() >= target_front) { out.stop_reason = "front_past_step"; break; }
+    if (scene.max_steps > 0 && sim.steps() >= scene.max_steps) { out.stop_reason = "max_steps"; break; }
+    if (sim.particles().size() == 0) { out.stop_reason = "no_ice_left"; break; }
+    sim.step();
+    maybe_output();
+    const double wall = std::chrono::duration<double>(clock::now() - t0).count();
+    if (scene.wall_time_limit > 0 && wall > scene.wall_time_limit) {
+      throw SimulationError("time limit: run.wall_time_limit = " + std::to_string(scene.wall_time_limit) +
+                            " s reached at t = " + std::to_string(sim.time()) + " s, step " +
+                            std::to_string(sim.steps()) + " (" +
+                            std::to_string(static_cast<int>(100 * fraction())) + "% done)");
+    }
+    if (obs && wall - last_report >= obs->progress_interval_s()) {
+      RunProgress pr;
+      const double span = wall - last_report;
+      pr.sim_time_s = sim.time();
+      pr.fraction_done = fraction();
+      pr.steps = sim.steps();
+      pr.particles = sim.particles().size();
+      pr.steps_per_second = (sim.steps() - last_steps) / span;
+      pr.particle_steps_per_second = (sim.particle_steps() - last_psteps) / span;
+      pr.eta_s = pr.fraction_done > 0 ? wall * (1.0 - pr.fraction_done) / pr.fraction_done : 0.0;
+      pr.front_x_m = sim.front_x();
+      pr.wall_s = wall;
+      obs->on_progress(pr);
+      last_report = wall;
+      last_steps = sim.steps();
+      last_psteps = sim.particle_steps();
+      if (obs->cancelled()) { out.stop_reason = "cancelled"; break; }
+    }
+  }
+  out.steps = sim.steps();
+  out.particle_steps = sim.particle_steps();
+  out.return_map_evaluations = sim.return_map_evaluations();
+  out.sim_time_s = sim.time();
+  out.final_mass = sim.total_mass();
+  out.removed_mass = sim.removed_mass();
+  out.final_particles = sim.particles().size();
+  out.final_snapshot = sim.snapshot();
+  for (const auto& s : sim.stages()) out.stage_seconds[s.name] = {{"seconds", s.seconds}, {"calls", s.calls}};
+  out.wall_s = std::chrono::duration<double>(clock::now() - t0).count();
+  return out;
+}
+
+}  // namespace
+
+RunSummary run_scene(const SceneConfig& scene, RunObserver* observer) {
+  return scene.dim == 3 ? run_dim<3>(scene, observer) : run_dim<2>(scene, observer);
+}
+
+}  // namespace crevasse

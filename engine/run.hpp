@@ -1,0 +1,56 @@
+#pragma once
+// Runs one scene to its stop condition, dispatching on the dimension. Progress and output go
+// through an observer the caller passes in: the engine has no global logger.
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "engine/scene.hpp"
+#include "engine/snapshot.hpp"
+
+namespace crevasse {
+
+struct RunProgress {
+  double sim_time_s = 0.0;
+  double fraction_done = 0.0;  // of the stop condition that will end the run, in [0, 1]
+  std::int64_t steps = 0;
+  std::size_t particles = 0;
+  double steps_per_second = 0.0;
+  double particle_steps_per_second = 0.0;
+  double eta_s = 0.0;          // wall-clock estimate of the remaining time
+  double front_x_m = 0.0;
+  double wall_s = 0.0;
+};
+
+class RunObserver {
+ public:
+  virtual ~RunObserver() = default;
+  virtual void on_progress(const RunProgress&) {}
+  // Called at t = 0 and every scene.vtu_interval of simulated time, when that interval is > 0.
+  virtual void on_output(const ParticleSnapshot&, int /*index*/) {}
+  // Return true to stop the run early (cancellation); the run then ends with "cancelled".
+  virtual bool cancelled() { return false; }
+  // Wall seconds between on_progress calls.
+  virtual double progress_interval_s() const { return 2.0; }
+};
+
+struct RunSummary {
+  std::string stop_reason;  // "front_past_step", "end_time", "max_steps", "cancelled"
+  std::int64_t steps = 0;
+  std::int64_t particle_steps = 0;
+  std::int64_t return_map_evaluations = 0;
+  double sim_time_s = 0.0;
+  double wall_s = 0.0;
+  double initial_mass = 0.0;
+  double final_mass = 0.0;
+  double removed_mass = 0.0;
+  std::size_t initial_particles = 0;
+  std::size_t final_particles = 0;
+  nlohmann::json stage_seconds;  // per stage: seconds and calls
+  ParticleSnapshot final_snapshot;
+};
+
+// Throws SimulationError on instability or when run.wall_time_limit is exceeded.
+RunSummary run_scene(const SceneConfig& scene, RunObserver* observer = nullptr);
+
+}  // namespace crevasse

@@ -1,0 +1,113 @@
+#pragma once
+// Everything one simulation needs, in SI units, with every default in one place
+// (scene_defaults()). Loaded from a scene JSON file (documented in README.md and
+// docs/scene_format.md) or built in code by tests. Unknown keys are refused, so a typo in a
+// study file never silently runs the default.
+#include <array>
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace crevasse {
+
+// What a scene calls for. The engine assembles its step from exactly these (SPEC §4).
+enum class Effect {
+  gravity,              // body force
+  drive,                // piston pushing the back face at drive_speed
+  basal_friction,       // Coulomb contact with the bed
+  lateral_walls,        // free-slip walls at y = 0 and y = width (3D)
+  box_walls,            // free-slip walls on the domain faces of the axes in wall_axes
+  plasticity,           // capped von Mises return mapping
+  softening,            // cap softens with ε_v^p (needs plasticity)
+  outflow,              // remove ice that leaves the downstream end
+  velocity_boundaries,  // boxes of grid nodes moving at a prescribed velocity
+};
+const char* effect_name(Effect e);
+Effect effect_from_name(const std::string& name);  // throws InputError
+
+struct VelocityBox {
+  std::array<double, 3> min{}, max{};   // initial extent [m] (z is the last used axis)
+  std::array<double, 3> velocity{};     // [m/s]; the box moves with it
+};
+
+struct SceneConfig {
+  std::string name = "scene";
+  int dim = 2;
+  std::vector<Effect> effects;
+
+  // Ice (SPEC §2 defaults)
+  double density = 917.0;             // ρ_i [kg/m³]
+  double youngs_modulus = 1.0e9;      // E [Pa]
+  double poisson_ratio = 0.3;         // ν [-]
+  double tensile_strength = 1.0e6;    // c [Pa], 2D convention p = −(τ_xx + τ_zz)/2
+  double shear_strength = 1.0e7;      // q_y [Pa]
+  // Softening: ζ = zeta_ref · dx / dx_ref (crack band: same G = c·h/ζ at every dx), unless
+  // softening_zeta > 0 is given explicitly or fracture_energy > 0 (then ζ = c·dx/G).
+  double zeta_ref = 500.0;
+  double dx_ref = 10.0;
+  double softening_zeta = 0.0;        // resolved ζ (0 until resolve())
+  double fracture_energy = 0.0;       // G [J/m²]; 0 = derived from zeta_ref
+
+  // Geometry
+  std::string body = "slab";          // "slab": glacier on the plateau; "box": box_min..box_max
+  double ice_thickness = 100.0;       // H_i [m]
+  double upstream_length = 0.0;       // slab length on the plateau [m]; 0 → 5·H_i
+  double width = 0.0;                 // W_i [m] (3D); 0 → H_i
+  std::array<double, 3> box_min{}, box_max{};  // body "box" extent [m]
+  std::string initial_stress = "geostatic";    // "geostatic" or "none"
+
+  // Bed
+  std::string bed_shape = "step";     // "step", "concave", "flat", "none"
+  double step_height = 100.0;         // H_s [m]
+  double step_length = 100.0;         // L_s [m]; 0 = vertical step
+  double downstream_length = 0.0;     // floor length past the step [m]; 0 → 10·H_i
+  double bed_friction = 0.1;          // μ_b [-]
+  double flat_bed_z = 0.0;            // bed "flat": its height [m]
+
+  double drive_speed = 4.0;           // V_x [m/s]
+  // The piston accelerates smoothly, v = V_x (1 − cos(π t/T))/2 for t < T: an impulsive start
+  // sends a ρ c_p V_x ≈ 4 MPa stress wave through the slab, which cracks it everywhere. T much
+  // longer than the wave transit time makes the start quasi-static. 0 → 10 L_up / c_p.
+  double drive_ramp_time = 0.0;       // T [s]
+  double gravity = 9.81;              // g [m/s²]
+  double gravity_tilt_deg = 0.0;      // tilt of gravity towards +x (incline tests) [deg]
+
+  // Numerics
+  double dx = 10.0;                   // grid spacing [m]
+  int particles_per_cell_axis = 2;    // 2 → 4 per cell in 2D, 8 in 3D
+  double cfl = 0.5;                   // dt = cfl·dx/(c_p + max|v|)
+  double jitter = 0.0;                // random particle offset, fraction of particle spacing
+  std::uint64_t seed = 1;             // jitter seed (study replicas)
+  double top_margin = 0.0;            // air above the ice [m]; 0 → 0.5·H_i + 4·dx
+  std::array<double, 3> domain_min{}, domain_max{};  // body "box": explicit domain [m]
+  std::vector<int> wall_axes;         // box_walls: axes with free-slip walls on both faces
+  std::vector<VelocityBox> velocity_boxes;
+
+  // Run control
+  double end_time = 0.0;              // [s]; 0 → until front_past_step
+  double front_past_step = 0.0;       // stop when the front is this far past the step foot [m]
+  std::int64_t max_steps = 0;         // 0 = unlimited
+  double wall_time_limit = 0.0;       // [s]; 0 = unlimited
+
+  // Output (crevasse run)
+  double vtu_interval = 0.0;          // simulated seconds between VTU snapshots; 0 = none
+  bool png = true;                    // side view at the end
+
+  bool has(Effect e) const;
+  // Fills derived values (lengths defaulting to multiples of H_i, ζ from dx, the domain) and
+  // checks every field; throws InputError naming the field and the allowed range.
+  void resolve();
+  // Derived quantities (valid after resolve()).
+  double step_top_x() const { return upstream_length; }
+  double step_foot_x() const { return upstream_length + step_length; }
+  double p_wave_speed() const;
+  double drive_velocity(double t) const;  // piston speed at time t [m/s]
+  double drive_position(double t) const;  // piston face x at time t (0 at t = 0) [m]
+  double implied_fracture_energy() const;  // G = c·dx/ζ [J/m²] (band width h = dx)
+};
+
+SceneConfig scene_from_json(const nlohmann::json& j);  // resolve()d; throws InputError
+nlohmann::json scene_to_json(const SceneConfig& s);    // canonical, every field explicit
+
+}  // namespace crevasse

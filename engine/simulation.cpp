@@ -1,0 +1,665 @@
+#include "engine/simulation.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <sstream>
+
+#include "engine/bspline.hpp"
+#include "engine/error.hpp"
+
+namespace crevasse {
+namespace {
+
+// P2G colouring: a particle with stencil base b writes nodes b..b+2 along x. Slabs of 4 cells
+// write 6 node columns, so slabs of one parity never share a node and run in parallel.
+constexpr int kSlabCells = 4;
+// Re-sorting particles by cell restores memory locality; every ~100 steps costs ~1% and never
+// costs ~17% (research_performance.md).
+constexpr int kSortInterval = 100;
+constexpr std::size_t kGrain = 1024;
+
+template <int Dim>
+Vec<Dim> to_vec(const std::array<double, 3>& a) {
+  Vec<Dim> v;
+  for (int i = 0; i < Dim; ++i) v[i] = a[i];
+  return v;
+}
+
+std::string describe_position(const double* x, int dim) {
+  std::ostringstream o;
+  o << "(";
+  for (int a = 0; a < dim; ++a) o << (a ? ", " : "") << x[a];
+  o << ") m";
+  return o.str();
+}
+
+}  // namespace
+
+template <int Dim>
+Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
+  if (scene_.dim != Dim) throw InputError("dim: scene is " + std::to_string(scene_.dim) + "D");
+  moduli_ = ElasticModuli::from_young_poisson(scene_.youngs_modulus, scene_.poisson_ratio);
+  plastic_.tensile_strength_c = scene_.tensile_strength;
+  plastic_.shear_strength_qy = scene_.shear_strength;
+  plastic_.softening_zeta = scene_.has(Effect::softening) ? scene_.softening_zeta : 0.0;
+  grid_.dx = scene_.dx;
+  domain_lo_ = to_vec<Dim>(scene_.domain_min);
+  domain_hi_ = to_vec<Dim>(scene_.domain_max);
+
+  const double x_lo = scene_.domain_min[0], x_hi = scene_.domain_max[0];
+  if (scene_.bed_shape == "step") {
+    bed_ = Bed::step(scene_.step_top_x(), scene_.step_height, scene_.step_length, x_lo, x_hi);
+  } else if (scene_.bed_shape == "concave") {
+    bed_ = Bed::concave(scene_.step_top_x(), scene_.step_height, scene_.step_length, x_lo, x_hi);
+  } else if (scene_.bed_shape == "flat") {
+    bed_ = Bed::flat(scene_.flat_bed_z, x_lo, x_hi);
+  }
+  if (bed_) build_bed_table();
+  seed_particles();
+
+  // Assemble the step from the scene's effects (SPEC §4).
+  const double g = scene_.has(Effect::gravity) ? scene_.gravity : 0.0;
+  Vec<Dim> gravity = Vec<Dim>::Zero();
+  const double tilt = scene_.gravity_tilt_deg * std::numbers::pi / 180.0;
+  gravity[0] = g * std::sin(tilt);
+  gravity[up_axis<Dim>] = -g * std::cos(tilt);
+
+  add_stage("prepare_grid", [this] { prepare_grid(); });
+  add_stage("p2g", [this] { particle_to_grid(); });
+  add_stage(g != 0.0 ? "grid_velocity_gravity" : "grid_velocity",
+            [this, gravity] { grid_velocity(gravity); });
+  if (scene_.has(Effect::drive)) add_stage("drive", [this] { apply_drive_to_grid(); });
+  if (scene_.has(Effect::basal_friction))
+    add_stage("basal_friction", [this] { apply_bed_friction_to_grid(); });
+  if (scene_.has(Effect::lateral_walls)) {
+    add_stage("lateral_walls", [this] {
+      apply_walls_to_grid({1}, domain_lo_, domain_hi_);
+    });
+  }
+  if (scene_.has(Effect::box_walls)) {
+    add_stage("box_walls", [this] {
+      apply_walls_to_grid(scene_.wall_axes, domain_lo_, domain_hi_);
+    });
+  }
+  if (scene_.has(Effect::velocity_boundaries))
+    add_stage("velocity_boundaries", [this] { apply_velocity_boxes_to_grid(); });
+  if (scene_.has(Effect::plasticity)) {
+    add_stage("g2p_return_mapping", [this] { grid_to_particle<true>(); });
+  } else {
+    add_stage("g2p_elastic", [this] { grid_to_particle<false>(); });
+  }
+  if (scene_.has(Effect::basal_friction))
+    add_stage("bed_projection", [this] { project_particles_out_of_bed(); });
+  if (scene_.has(Effect::drive)) {
+    add_stage("drive_clamp", [this] {
+      clamp_particles(0, scene_.drive_position(time_), domain_hi_[0]);
+    });
+  }
+  // Particles never leave the domain: the last line of defence, whatever the effects.
+  add_stage("domain_clamp", [this] {
+    for (int a = 0; a < Dim; ++a) clamp_particles(a, domain_lo_[a], domain_hi_[a]);
+  });
+  if (scene_.has(Effect::outflow)) add_stage("outflow", [this] { remove_outflow(); });
+  add_stage("time_step", [this] { update_time_step(); });
+
+  update_time_step();
+  // The first step's dt comes from the initial state only: no instability check yet.
+}
+
+template <int Dim>
+void Simulation<Dim>::add_stage(std::string name, std::function<void()> run) {
+  stages_.push_back({name, 0, 0.0});
+  stage_fns_.push_back({std::move(name), std::move(run)});
+}
+
+template <int Dim>
+void Simulation<Dim>::build_bed_table() {
+  const int x_axis = 0, z_axis = up_axis<Dim>;
+  const double dx = scene_.dx;
+  bed_i0_ = static_cast<int>(std::floor(domain_lo_[x_axis] / dx)) - 3;
+  bed_k0_ = static_cast<int>(std::floor(domain_lo_[z_axis] / dx)) - 3;
+  bed_ni_ = static_cast<int>(std::ceil(domain_hi_[x_axis] / dx)) + 4 - bed_i0_;
+  bed_nk_ = static_cast<int>(std::ceil(domain_hi_[z_axis] / dx)) + 4 - bed_k0_;
+  bed_phi_.resize(static_cast<std::size_t>(bed_ni_) * bed_nk_);
+  bed_normal_.resize(bed_phi_.size());
+  tbb::parallel_for(0, bed_ni_, [&](int i) {
+    for (int k = 0; k < bed_nk_; ++k) {
+      const double x = (bed_i0_ + i) * dx, z = (bed_k0_ + k) * dx;
+      const std::size_t f = static_cast<std::size_t>(i) * bed_nk_ + k;
+      bed_phi_[f] = bed_->signed_distance(x, z);
+      bed_normal_[f] = bed_->normal(x, z);
+    }
+  });
+}
+
+template <int Dim>
+double Simulation<Dim>::bed_phi(const Vec<Dim>& x, Vec<Dim>* normal) const {
+  // Bilinear interpolation of the node table in (x, z).
+  const double dx = scene_.dx;
+  const double gx = x[0] / dx - bed_i0_, gz = x[up_axis<Dim>] / dx - bed_k0_;
+  const int i = std::clamp(static_cast<int>(std::floor(gx)), 0, bed_ni_ - 2);
+  const int k = std::clamp(static_cast<int>(std::floor(gz)), 0, bed_nk_ - 2);
+  const double fx = std::clamp(gx - i, 0.0, 1.0), fz = std::clamp(gz - k, 0.0, 1.0);
+  const double w[4] = {(1 - fx) * (1 - fz), (1 - fx) * fz, fx * (1 - fz), fx * fz};
+  const std::size_t f[4] = {static_cast<std::size_t>(i) * bed_nk_ + k,
+                            static_cast<std::size_t>(i) * bed_nk_ + k + 1,
+                            static_cast<std::size_t>(i + 1) * bed_nk_ + k,
+                            static_cast<std::size_t>(i + 1) * bed_nk_ + k + 1};
+  double phi = 0.0, nx = 0.0, nz = 0.0;
+  for (int c = 0; c < 4; ++c) {
+    phi += w[c] * bed_phi_[f[c]];
+    nx += w[c] * bed_normal_[f[c]][0];
+    nz += w[c] * bed_normal_[f[c]][1];
+  }
+  if (normal) {
+    normal->setZero();
+    const double len = std::hypot(nx, nz);
+    (*normal)[0] = len > 0 ? nx / len : 0.0;
+    (*normal)[up_axis<Dim>] = len > 0 ? nz / len : 1.0;
+  }
+  return phi;
+}
+
+template <int Dim>
+void Simulation<Dim>::seed_particles() {
+  const double dx = scene_.dx;
+  const int ppc = scene_.particles_per_cell_axis;
+  const double h = dx / ppc;  // particle spacing
+  const double rho = scene_.density;
+  Vec<Dim> lo, hi;
+  double surface_z;
+  if (scene_.body == "slab") {
+    lo.setZero();
+    hi.setZero();
+    lo[0] = 0.0;
+    hi[0] = scene_.upstream_length;
+    lo[up_axis<Dim>] = scene_.step_height;
+    hi[up_axis<Dim>] = scene_.step_height + scene_.ice_thickness;
+    if constexpr (Dim == 3) {
+      lo[1] = 0.0;
+      hi[1] = scene_.width;
+    }
+  } else {
+    lo = to_vec<Dim>(scene_.box_min);
+    hi = to_vec<Dim>(scene_.box_max);
+  }
+  surface_z = hi[up_axis<Dim>];
+
+  IVec<Dim> count;
+  for (int a = 0; a < Dim; ++a) count[a] = std::max(1, static_cast<int>(std::round((hi[a] - lo[a]) / h)));
+  std::mt19937_64 rng(scene_.seed);
+  std::uniform_real_distribution<double> jitter(-scene_.jitter * h, scene_.jitter * h);
+
+  // Geostatic initial stress (research_physics.md §1): σ_zz = −ρ g (s − z), lateral stresses
+  // K0·σ_zz with K0 = ν/(1 − ν), the uniaxial-strain state of a laterally confined slab. It is
+  // loaded into F_E through the inverse Hencky law with τ = J σ (two fixed-point passes: J − 1
+  // is of order 1e-3, so the second pass already changes τ by ~1e-6 relative).
+  const bool geostatic = scene_.initial_stress == "geostatic" && scene_.has(Effect::gravity);
+  const double g_vertical = scene_.gravity * std::cos(scene_.gravity_tilt_deg * std::numbers::pi / 180.0);
+  const double k0 = scene_.poisson_ratio / (1.0 - scene_.poisson_ratio);
+  const double cell_volume = std::pow(h, Dim);
+
+  std::size_t total = 1;
+  for (int a = 0; a < Dim; ++a) total *= static_cast<std::size_t>(count[a]);
+  particles_.x.reserve(total);
+  IVec<Dim> idx = IVec<Dim>::Zero();
+  for (std::size_t n = 0; n < total; ++n) {
+    std::size_t r = n;
+    for (int a = Dim - 1; a >= 0; --a) {
+      idx[a] = static_cast<int>(r % count[a]);
+      r /= count[a];
+    }
+    Vec<Dim> pos;
+    for (int a = 0; a < Dim; ++a) pos[a] = lo[a] + (idx[a] + 0.5) * h + jitter(rng);
+    Mat<Dim> fe = Mat<Dim>::Identity();
+    Mat<Dim> tau = Mat<Dim>::Zero();
+    double vol0 = cell_volume;
+    if (geostatic) {
+      Vec<Dim> sigma = Vec<Dim>::Constant(-k0 * rho * g_vertical * (surface_z - pos[up_axis<Dim>]));
+      sigma[up_axis<Dim>] = -rho * g_vertical * (surface_z - pos[up_axis<Dim>]);
+      Vec<Dim> tau_p = sigma;
+      Vec<Dim> eps = Vec<Dim>::Zero();
+      for (int pass = 0; pass < 2; ++pass) {
+        eps = hencky_strain_from_kirchhoff<Dim>(moduli_, tau_p);
+        tau_p = sigma * std::exp(eps.sum());
+      }
+      fe = eps.array().exp().matrix().asDiagonal();
+      tau = principal_kirchhoff<Dim>(moduli_, eps).asDiagonal();
+      vol0 = cell_volume / std::exp(eps.sum());  // the lattice volume is the compressed one
+    }
+    particles_.push_back(pos, rho * cell_volume, vol0, fe, tau);
+  }
+  if (scene_.has(Effect::plasticity)) particles_.eps_v_p.assign(particles_.size(), 0.0);
+}
+
+template <int Dim>
+void Simulation<Dim>::step() {
+  for (std::size_t s = 0; s < stage_fns_.size(); ++s) {
+    const auto t0 = std::chrono::steady_clock::now();
+    stage_fns_[s].run();
+    stages_[s].seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ++stages_[s].calls;
+  }
+}
+
+template <int Dim>
+void Simulation<Dim>::prepare_grid() {
+  auto& P = particles_;
+  const std::size_t n = P.size();
+  if (n == 0) {
+    grid_.reset(IVec<Dim>::Zero(), IVec<Dim>::Ones());
+    slab_start_.assign(2, 0);
+    slab_order_.clear();
+    return;
+  }
+  const double inv_dx = 1.0 / scene_.dx;
+  if (steps_ % kSortInterval == 0) {
+    // Sort by cell (x slowest) for locality in P2G/G2P.
+    std::vector<std::uint64_t> key(n);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), [&](const auto& r) {
+      for (std::size_t p = r.begin(); p != r.end(); ++p) {
+        std::uint64_t k = 0;
+        for (int a = 0; a < Dim; ++a)
+          k = (k << 20) | static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(P.x[p][a] * inv_dx)) + (1 << 19));
+        key[p] = k;
+      }
+    });
+    std::vector<std::uint32_t> order(n);
+    std::iota(order.begin(), order.end(), 0u);
+    std::stable_sort(order.begin(), order.end(), [&](auto a, auto b) { return key[a] < key[b]; });
+    P.permute(order);
+  }
+  // Node box covering every particle's stencil.
+  using Range = std::pair<IVec<Dim>, IVec<Dim>>;
+  const IVec<Dim> big = IVec<Dim>::Constant(std::numeric_limits<int>::max());
+  const Range box = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, n, kGrain), Range{big, -big},
+      [&](const auto& r, Range acc) {
+        for (std::size_t p = r.begin(); p != r.end(); ++p) {
+          for (int a = 0; a < Dim; ++a) {
+            const int b = static_cast<int>(std::floor(P.x[p][a] * inv_dx - 0.5));
+            acc.first[a] = std::min(acc.first[a], b);
+            acc.second[a] = std::max(acc.second[a], b + 2);
+          }
+        }
+        return acc;
+      },
+      [](Range a, const Range& b) {
+        return Range{a.first.cwiseMin(b.first), a.second.cwiseMax(b.second)};
+      });
+  grid_.reset(box.first, (box.second - box.first).array() + 1);
+
+  // Counting sort of particle indices into x-slabs (stable: fixed summation order, so P2G is
+  // deterministic whatever the thread count).
+  const int slabs = (grid_.n[0] + kSlabCells - 1) / kSlabCells;
+  slab_start_.assign(static_cast<std::size_t>(slabs) + 1, 0);
+  std::vector<std::uint32_t> slab_of(n);
+  for (std::size_t p = 0; p < n; ++p) {
+    const int b = static_cast<int>(std::floor(P.x[p][0] * inv_dx - 0.5)) - grid_.lo[0];
+    slab_of[p] = static_cast<std::uint32_t>(b / kSlabCells);
+    ++slab_start_[slab_of[p] + 1];
+  }
+  for (int s = 0; s < slabs; ++s) slab_start_[s + 1] += slab_start_[s];
+  slab_order_.resize(n);
+  std::vector<std::uint32_t> fill(slab_start_.begin(), slab_start_.end() - 1);
+  for (std::size_t p = 0; p < n; ++p) slab_order_[fill[slab_of[p]]++] = static_cast<std::uint32_t>(p);
+}
+
+template <int Dim>
+void Simulation<Dim>::particle_to_grid() {
+  const auto& P = particles_;
+  const double dx = scene_.dx, inv_dx = 1.0 / dx;
+  const double d_inv = 4.0 * inv_dx * inv_dx;  // MLS inertia-like tensor inverse for quadratic B-splines
+  const double dt = dt_;
+  const int slabs = static_cast<int>(slab_start_.size()) - 1;
+  for (int colour = 0; colour < 2; ++colour) {
+    tbb::parallel_for(0, (slabs + 1 - colour) / 2, [&](int half) {
+      const int s = 2 * half + colour;
+      for (std::uint32_t q = slab_start_[s]; q < slab_start_[s + 1]; ++q) {
+        const std::uint32_t p = slab_order_[q];
+        const Vec<Dim> xg = P.x[p] * inv_dx;
+        const StencilWeights<Dim> w(xg);
+        const IVec<Dim> base = w.base();
+        // MLS-MPM (Hu et al. 2018): stress enters as an affine momentum term,
+        // −dt·V0·τ·D⁻¹ with D⁻¹ = 4/dx² for quadratic B-splines.
+        const Mat<Dim> affine = P.mass[p] * P.C[p] - (dt * d_inv * P.vol0[p]) * P.tau[p];
+        const Vec<Dim> mv = P.mass[p] * P.v[p];
+        for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
+          const IVec<Dim> node = base + off;
+          const Vec<Dim> dpos = (node.template cast<double>() - xg) * dx;
+          const std::size_t f = grid_.flat(node);
+          grid_.mass[f] += wt * P.mass[p];
+          grid_.vel[f] += wt * (mv + affine * dpos);
+        });
+      }
+    });
+  }
+}
+
+template <int Dim>
+void Simulation<Dim>::grid_velocity(const Vec<Dim>& gravity) {
+  const double dt = dt_;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid_.node_count(), kGrain), [&](const auto& r) {
+    for (std::size_t f = r.begin(); f != r.end(); ++f) {
+      if (grid_.mass[f] > 0.0) grid_.vel[f] = grid_.vel[f] / grid_.mass[f] + dt * gravity;
+    }
+  });
+}
+
+template <int Dim>
+void Simulation<Dim>::apply_drive_to_grid() {
+  // The piston face sits at x_w = V t and moves at V: nodes at or behind it cannot move slower
+  // than the piston (contact that allows separation, no friction on the face).
+  const double xw = scene_.drive_position(time_);
+  const double v = scene_.drive_velocity(time_);
+  const int last = static_cast<int>(std::floor(xw / grid_.dx)) - grid_.lo[0];
+  if (last < 0) return;
+  const std::size_t end = std::min(grid_.node_count(),
+                                   static_cast<std::size_t>(last + 1) * (grid_.node_count() / grid_.n[0]));
+  for (std::size_t f = 0; f < end; ++f)
+    if (grid_.mass[f] > 0.0) grid_.vel[f][0] = std::max(grid_.vel[f][0], v);
+}
+
+template <int Dim>
+void Simulation<Dim>::apply_bed_friction_to_grid() {
+  // Coulomb contact with the static bed on nodes inside or on it: remove the approaching normal
+  // velocity v_n < 0 and reduce the tangential velocity by μ|v_n| (stick if it would reverse).
+  // Separating nodes (v_n ≥ 0) are free, so ice may lift off the bed.
+  const double mu = scene_.bed_friction;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid_.node_count(), kGrain), [&](const auto& r) {
+    for (std::size_t f = r.begin(); f != r.end(); ++f) {
+      if (grid_.mass[f] <= 0.0) continue;
+      const IVec<Dim> node = grid_.node_of(f);
+      const int i = node[0] - bed_i0_, k = node[up_axis<Dim>] - bed_k0_;
+      if (i < 0 || k < 0 || i >= bed_ni_ || k >= bed_nk_) continue;
+      const std::size_t t = static_cast<std::size_t>(i) * bed_nk_ + k;
+      // Nodes on the bed surface have φ = 0 up to round-off in the distance computation.
+      if (bed_phi_[t] > 1e-6 * grid_.dx) continue;
+      Vec<Dim> n = Vec<Dim>::Zero();
+      n[0] = bed_normal_[t][0];
+      n[up_axis<Dim>] = bed_normal_[t][1];
+      Vec<Dim>& v = grid_.vel[f];
+      const double vn = v.dot(n);
+      if (vn >= 0.0) continue;
+      Vec<Dim> vt = v - vn * n;
+      const double vt_norm = vt.norm();
+      if (vt_norm <= -mu * vn) vt.setZero();
+      else vt *= 1.0 + mu * vn / vt_norm;
+      v = vt;
+    }
+  });
+}
+
+template <int Dim>
+void Simulation<Dim>::apply_walls_to_grid(const std::vector<int>& axes, const Vec<Dim>& lo,
+                                          const Vec<Dim>& hi) {
+  // Free slip: on nodes at or beyond a wall the velocity into the wall is removed.
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid_.node_count(), kGrain), [&](const auto& r) {
+    for (std::size_t f = r.begin(); f != r.end(); ++f) {
+      if (grid_.mass[f] <= 0.0) continue;
+      const Vec<Dim> xn = grid_.position(grid_.node_of(f));
+      for (int a : axes) {
+        if (xn[a] <= lo[a] + 1e-9 * grid_.dx) grid_.vel[f][a] = std::max(grid_.vel[f][a], 0.0);
+        if (xn[a] >= hi[a] - 1e-9 * grid_.dx) grid_.vel[f][a] = std::min(grid_.vel[f][a], 0.0);
+      }
+    }
+  });
+}
+
+template <int Dim>
+void Simulation<Dim>::apply_velocity_boxes_to_grid() {
+  for (const auto& b : scene_.velocity_boxes) {
+    const Vec<Dim> v = to_vec<Dim>(b.velocity);
+    const Vec<Dim> lo = to_vec<Dim>(b.min) + v * time_, hi = to_vec<Dim>(b.max) + v * time_;
+    for (std::size_t f = 0; f < grid_.node_count(); ++f) {
+      if (grid_.mass[f] <= 0.0) continue;
+      const Vec<Dim> xn = grid_.position(grid_.node_of(f));
+      if ((xn.array() >= lo.array()).all() && (xn.array() <= hi.array()).all()) grid_.vel[f] = v;
+    }
+  }
+}
+
+template <int Dim>
+template <bool Plastic>
+void Simulation<Dim>::grid_to_particle() {
+  auto& P = particles_;
+  const double dx = scene_.dx, inv_dx = 1.0 / dx;
+  const double d_inv = 4.0 * inv_dx * inv_dx;
+  const double dt = dt_;
+  const ElasticModuli m = moduli_;
+  const CappedVonMisesParams pl = plastic_;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, P.size(), kGrain), [&](const auto& r) {
+    for (std::size_t p = r.begin(); p != r.end(); ++p) {
+      const Vec<Dim> xg = P.x[p] * inv_dx;
+      const StencilWeights<Dim> w(xg);
+      const IVec<Dim> base = w.base();
+      Vec<Dim> v = Vec<Dim>::Zero();
+      Mat<Dim> b = Mat<Dim>::Zero();
+      for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
+        const IVec<Dim> node = base + off;
+        const Vec<Dim> dpos = (node.template cast<double>() - xg) * dx;
+        const Vec<Dim>& vi = grid_.vel[grid_.flat(node)];
+        v += wt * vi;
+        b += wt * vi * dpos.transpose();
+      });
+      P.v[p] = v;
+      P.C[p] = d_inv * b;
+      P.x[p] += dt * v;
+      Mat<Dim> fe = (Mat<Dim>::Identity() + dt * P.C[p]) * P.F_e[p];
+      PrincipalStretch<Dim> s = principal_hencky<Dim>(fe);
+      if constexpr (Plastic) {
+        const ReturnResult<Dim> ret = return_map_capped_von_mises<Dim>(s.eps, P.eps_v_p[p], m, pl);
+        if (ret.cap_active || ret.shear_active) {
+          // F_E = U exp(ε') Uᵀ R: rescale the left stretch in its principal frame.
+          const Vec<Dim> scale = (ret.eps - s.eps).array().exp();
+          fe = s.U * scale.asDiagonal() * s.U.transpose() * fe;
+          s.eps = ret.eps;
+          P.eps_v_p[p] += ret.delta_eps_v;
+        }
+      }
+      P.F_e[p] = fe;
+      P.tau[p] = kirchhoff_stress<Dim>(m, s);
+    }
+  });
+  if constexpr (Plastic) return_map_evaluations_ += static_cast<std::int64_t>(P.size());
+  particle_steps_ += static_cast<std::int64_t>(P.size());
+  time_ += dt_;
+  ++steps_;
+}
+
+template <int Dim>
+void Simulation<Dim>::project_particles_out_of_bed() {
+  auto& P = particles_;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, P.size(), kGrain), [&](const auto& r) {
+    for (std::size_t p = r.begin(); p != r.end(); ++p) {
+      Vec<Dim> n;
+      const double phi = bed_phi(P.x[p], &n);
+      if (phi < 0.0) P.x[p] -= phi * n;
+    }
+  });
+}
+
+template <int Dim>
+void Simulation<Dim>::clamp_particles(int axis, double lo, double hi) {
+  auto& P = particles_;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, P.size(), kGrain), [&](const auto& r) {
+    for (std::size_t p = r.begin(); p != r.end(); ++p) P.x[p][axis] = std::clamp(P.x[p][axis], lo, hi);
+  });
+}
+
+template <int Dim>
+void Simulation<Dim>::remove_outflow() {
+  // Ice within three cells of the downstream end has left the scene (SPEC §2).
+  const double x_out = domain_hi_[0] - 3.0 * scene_.dx;
+  auto& P = particles_;
+  bool any = false;
+  std::vector<char> keep(P.size());
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    keep[p] = P.x[p][0] < x_out;
+    any |= !keep[p];
+  }
+  if (any) removed_mass_ += P.compact(keep);
+}
+
+template <int Dim>
+void Simulation<Dim>::update_time_step() {
+  const auto& P = particles_;
+  struct Acc {
+    double v2 = 0.0;
+    double front = -std::numeric_limits<double>::infinity();
+    std::int64_t bad = -1;  // a particle with a non-finite state
+  };
+  const Acc acc = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, P.size(), kGrain), Acc{},
+      [&](const auto& r, Acc a) {
+        for (std::size_t p = r.begin(); p != r.end(); ++p) {
+          const double v2 = P.v[p].squaredNorm();
+          if (!std::isfinite(v2) || !P.tau[p].allFinite()) {
+            if (a.bad < 0) a.bad = static_cast<std::int64_t>(p);
+            continue;
+          }
+          a.v2 = std::max(a.v2, v2);
+          a.front = std::max(a.front, P.x[p][0]);
+        }
+        return a;
+      },
+      [](Acc a, const Acc& b) {
+        a.v2 = std::max(a.v2, b.v2);
+        a.front = std::max(a.front, b.front);
+        if (a.bad < 0 || (b.bad >= 0 && b.bad < a.bad)) a.bad = b.bad;
+        return a;
+      });
+  const double dx = scene_.dx;
+  if (acc.bad >= 0) {
+    const auto p = static_cast<std::size_t>(acc.bad);
+    throw SimulationError("step " + std::to_string(steps_) + ", t = " + std::to_string(time_) +
+                          " s: particle " + std::to_string(p) + " at " +
+                          describe_position(P.x[p].data(), Dim) +
+                          " has a non-finite velocity or stress (numerical instability; lower "
+                          "numerics.cfl, now " + std::to_string(scene_.cfl) + ")");
+  }
+  const double vmax = std::sqrt(acc.v2);
+  if (steps_ > 0 && vmax * dt_ > dx) {
+    // The CFL step bounds |v|·dt by cfl·dx with the velocities of the previous step; a particle
+    // that moved more than a whole cell in one step means the update has blown up.
+    std::size_t worst = 0;
+    for (std::size_t p = 0; p < P.size(); ++p)
+      if (P.v[p].squaredNorm() >= acc.v2) worst = p;
+    throw SimulationError("step " + std::to_string(steps_) + ", t = " + std::to_string(time_) +
+                          " s: particle " + std::to_string(worst) + " at " +
+                          describe_position(P.x[worst].data(), Dim) + " moved " +
+                          std::to_string(vmax * dt_) + " m in one step (> dx = " +
+                          std::to_string(dx) + " m) at speed " + std::to_string(vmax) +
+                          " m/s: the explicit update is unstable (numerics.cfl = " +
+                          std::to_string(scene_.cfl) + "; keep it ≤ 1)");
+  }
+  max_speed_ = vmax;
+  front_x_ = P.size() ? acc.front : 0.0;
+  dt_ = scene_.cfl * dx / (scene_.p_wave_speed() + vmax);
+}
+
+template <int Dim>
+double Simulation<Dim>::total_mass() const {
+  double m = 0.0;
+  for (double v : particles_.mass) m += v;
+  return m;
+}
+
+template <int Dim>
+Vec<Dim> Simulation<Dim>::total_momentum() const {
+  Vec<Dim> s = Vec<Dim>::Zero();
+  for (std::size_t p = 0; p < particles_.size(); ++p) s += particles_.mass[p] * particles_.v[p];
+  return s;
+}
+
+template <int Dim>
+double Simulation<Dim>::kinetic_energy() const {
+  double e = 0.0;
+  for (std::size_t p = 0; p < particles_.size(); ++p)
+    e += 0.5 * particles_.mass[p] * particles_.v[p].squaredNorm();
+  return e;
+}
+
+template <int Dim>
+double Simulation<Dim>::gravitational_potential_energy() const {
+  double e = 0.0;
+  for (std::size_t p = 0; p < particles_.size(); ++p)
+    e += particles_.mass[p] * scene_.gravity * particles_.x[p][up_axis<Dim>];
+  return e;
+}
+
+template <int Dim>
+double Simulation<Dim>::cap_dissipated_energy() const {
+  if (!particles_.has_plastic_state()) return 0.0;
+  const double c = plastic_.tensile_strength_c, z = plastic_.softening_zeta;
+  double e = 0.0;
+  for (std::size_t p = 0; p < particles_.size(); ++p) {
+    const double eps = particles_.eps_v_p[p];
+    e += particles_.vol0[p] * (z > 0 ? c / z * (-std::expm1(-z * eps)) : c * eps);
+  }
+  return e;
+}
+
+template <int Dim>
+double Simulation<Dim>::max_yield_violation() const {
+  if (!particles_.has_plastic_state()) return 0.0;
+  double worst = -std::numeric_limits<double>::infinity();
+  for (std::size_t p = 0; p < particles_.size(); ++p) {
+    const double pr = pressure_of<Dim>(particles_.tau[p]);
+    const double q = von_mises_of<Dim>(particles_.tau[p]);
+    const double pc = cap_pressure(plastic_, particles_.eps_v_p[p]);
+    worst = std::max({worst, (pc - pr) / plastic_.tensile_strength_c,
+                      (q - plastic_.shear_strength_qy) / plastic_.tensile_strength_c});
+  }
+  return worst;
+}
+
+template <int Dim>
+ParticleSnapshot Simulation<Dim>::snapshot() const {
+  ParticleSnapshot s;
+  s.dim = Dim;
+  s.time_s = time_;
+  s.dx_m = scene_.dx;
+  s.softening_zeta = plastic_.softening_zeta;
+  s.tensile_strength_pa = scene_.tensile_strength;
+  s.ice_thickness_m = scene_.ice_thickness;
+  s.step_top_x_m = scene_.step_top_x();
+  s.step_foot_x_m = scene_.step_foot_x();
+  s.particle_spacing_m = scene_.dx / scene_.particles_per_cell_axis;
+  if (bed_) s.bed_profile = bed_->vertices();
+  const auto& P = particles_;
+  const std::size_t n = P.size();
+  s.x.resize(n); s.z.resize(n); s.vx.resize(n); s.vz.resize(n);
+  if (Dim == 3) { s.y.resize(n); s.vy.resize(n); }
+  s.eps_v_p.assign(n, 0.0);
+  s.pressure_pa.resize(n); s.von_mises_pa.resize(n); s.sigma_zz_pa.resize(n); s.volume_m3.resize(n);
+  constexpr int z = up_axis<Dim>;
+  for (std::size_t p = 0; p < n; ++p) {
+    s.x[p] = P.x[p][0];
+    s.z[p] = P.x[p][z];
+    s.vx[p] = P.v[p][0];
+    s.vz[p] = P.v[p][z];
+    if constexpr (Dim == 3) { s.y[p] = P.x[p][1]; s.vy[p] = P.v[p][1]; }
+    const double eps = P.has_plastic_state() ? P.eps_v_p[p] : 0.0;
+    s.eps_v_p[p] = eps;
+    s.pressure_pa[p] = pressure_of<Dim>(P.tau[p]);
+    s.von_mises_pa[p] = von_mises_of<Dim>(P.tau[p]);
+    const double j_e = P.F_e[p].determinant();
+    // Cauchy σ = V0 τ / V: the force of a particle is V0 τ (MLS) and V = V0 J_E J_P.
+    s.sigma_zz_pa[p] = P.tau[p](z, z) / (j_e * std::exp(eps));
+    s.volume_m3[p] = P.vol0[p] * j_e * std::exp(eps);  // J = J_E J_P, J_P = exp(ε_v^p)
+  }
+  return s;
+}
+
+template class Simulation<2>;
+template class Simulation<3>;
+
+}  // namespace crevasse

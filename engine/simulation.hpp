@@ -1,0 +1,120 @@
+#pragma once
+// One explicit MLS-MPM simulation (SPEC §4). It owns all of its state; nothing is shared
+// between simulations, so a study may run many at once. The step is a list of named, timed
+// stages assembled from the scene's effects in the constructor: an effect the scene does not
+// name adds no stage, and the material kernel (elastic or capped von Mises) is chosen once,
+// so an elastic scene never runs a return mapping.
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "engine/bed.hpp"
+#include "engine/capped_von_mises.hpp"
+#include "engine/grid.hpp"
+#include "engine/hencky.hpp"
+#include "engine/particles.hpp"
+#include "engine/scene.hpp"
+#include "engine/snapshot.hpp"
+
+namespace crevasse {
+
+struct StageStats {
+  std::string name;
+  std::int64_t calls = 0;
+  double seconds = 0.0;
+};
+
+template <int Dim>
+class Simulation {
+ public:
+  explicit Simulation(const SceneConfig& scene);  // scene must be resolve()d
+
+  void step();
+
+  double time() const { return time_; }
+  double last_dt() const { return dt_; }
+  std::int64_t steps() const { return steps_; }
+  const SceneConfig& scene() const { return scene_; }
+  const Particles<Dim>& particles() const { return particles_; }
+  Particles<Dim>& mutable_particles() { return particles_; }  // tests and initial conditions
+  const std::vector<StageStats>& stages() const { return stages_; }
+  std::int64_t return_map_evaluations() const { return return_map_evaluations_; }
+  std::int64_t particle_steps() const { return particle_steps_; }
+
+  // Diagnostics (conservation checks, hard-case assertions).
+  double total_mass() const;
+  double removed_mass() const { return removed_mass_; }
+  Vec<Dim> total_momentum() const;
+  double kinetic_energy() const;
+  double gravitational_potential_energy() const;
+  // Energy dissipated by the tensile cap, Σ V0 ∫ c e^{−ζε} dε = Σ V0 (c/ζ)(1 − e^{−ζ ε_v^p}).
+  double cap_dissipated_energy() const;
+  double front_x() const { return front_x_; }
+  double max_speed() const { return max_speed_; }
+  const Bed* bed() const { return bed_.has_value() ? &*bed_ : nullptr; }
+  // Largest yield-function value Φ over the particles, normalised by c (≤ ~0 when admissible).
+  double max_yield_violation() const;
+
+  ParticleSnapshot snapshot() const;
+
+ private:
+  struct Stage {
+    std::string name;
+    std::function<void()> run;
+  };
+  void add_stage(std::string name, std::function<void()> run);
+  void seed_particles();
+  void build_bed_table();
+
+  // Stages.
+  void prepare_grid();
+  void particle_to_grid();
+  void grid_velocity(const Vec<Dim>& gravity);
+  void apply_drive_to_grid();
+  void apply_bed_friction_to_grid();
+  void apply_walls_to_grid(const std::vector<int>& axes, const Vec<Dim>& lo, const Vec<Dim>& hi);
+  void apply_velocity_boxes_to_grid();
+  template <bool Plastic>
+  void grid_to_particle();
+  void project_particles_out_of_bed();
+  void clamp_particles(int axis, double lo, double hi);
+  void remove_outflow();
+  void update_time_step();
+
+  double bed_phi(const Vec<Dim>& x, Vec<Dim>* normal) const;
+
+  SceneConfig scene_;
+  ElasticModuli moduli_;
+  CappedVonMisesParams plastic_;
+  Particles<Dim> particles_;
+  Grid<Dim> grid_;
+  std::optional<Bed> bed_;
+  // Bed signed distance and normal on the lattice nodes of the domain, indexed (x, z).
+  std::vector<double> bed_phi_;
+  std::vector<std::array<double, 2>> bed_normal_;
+  int bed_i0_ = 0, bed_k0_ = 0, bed_ni_ = 0, bed_nk_ = 0;
+
+  std::vector<Stage> stage_fns_;
+  std::vector<StageStats> stages_;
+  // P2G colouring: particle indices grouped by x-slab of kSlabCells cells.
+  std::vector<std::uint32_t> slab_order_;
+  std::vector<std::uint32_t> slab_start_;
+
+  Vec<Dim> domain_lo_, domain_hi_;
+  double time_ = 0.0;
+  double dt_ = 0.0;
+  std::int64_t steps_ = 0;
+  std::int64_t particle_steps_ = 0;
+  std::int64_t return_map_evaluations_ = 0;
+  double removed_mass_ = 0.0;
+  double front_x_ = 0.0;
+  double max_speed_ = 0.0;
+};
+
+extern template class Simulation<2>;
+extern template class Simulation<3>;
+
+}  // namespace crevasse

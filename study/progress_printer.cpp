@@ -1,0 +1,34 @@
+#include "study/progress_printer.hpp"
+
+#include <unistd.h>
+
+#include <cmath>
+
+namespace crevasse {
+
+std::string format_duration(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "?";
+  const long s = std::lround(seconds);
+  char buf[64];
+  if (s >= 3600) std::snprintf(buf, sizeof buf, "%ldh%02ldm", s / 3600, (s % 3600) / 60);
+  else if (s >= 60) std::snprintf(buf, sizeof buf, "%ldm%02lds", s / 60, s % 60);
+  else std::snprintf(buf, sizeof buf, "%lds", s);
+  return buf;
+}
+
+ProgressPrinter::ProgressPrinter(std::FILE* out) : out_(out), tty_(isatty(fileno(out)) != 0) {}
+
+void ProgressPrinter::update(const std::string& line) {
+  if (tty_) std::fprintf(out_, "\r\033[K%s", line.c_str());
+  else std::fprintf(out_, "%s\n", line.c_str());
+  std::fflush(out_);
+  open_ = tty_;
+}
+
+void ProgressPrinter::finish() {
+  if (open_) std::fprintf(out_, "\n");
+  open_ = false;
+  std::fflush(out_);
+}
+
+}  // namespace crevasse

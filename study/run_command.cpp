@@ -1,0 +1,105 @@
+#include "study/run_command.hpp"
+
+#include <tbb/global_control.h>
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+
+#include "engine/error.hpp"
+#include "engine/run.hpp"
+#include "engine/vtu_writer.hpp"
+#include "study/progress_printer.hpp"
+
+namespace crevasse {
+namespace fs = std::filesystem;
+
+namespace {
+
+nlohmann::json read_json_file(const std::string& path) {
+  std::ifstream f(path);
+  if (!f) throw InputError(path + ": cannot open the file");
+  try {
+    return nlohmann::json::parse(f);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(path + ": not valid JSON (" + std::string(e.what()) + ")");
+  }
+}
+
+class CliObserver : public RunObserver {
+ public:
+  CliObserver(fs::path out, bool quiet) : out_(std::move(out)), quiet_(quiet) {}
+  void on_progress(const RunProgress& p) override {
+    if (quiet_) return;
+    char buf[256];
+    std::snprintf(buf, sizeof buf,
+                  "[%3.0f%%] t = %.1f s  front x = %.0f m  %lld steps  %.0f steps/s  %.2f M particle-steps/s  ETA %s",
+                  100.0 * p.fraction_done, p.sim_time_s, p.front_x_m, static_cast<long long>(p.steps),
+                  p.steps_per_second, p.particle_steps_per_second / 1e6, format_duration(p.eta_s).c_str());
+    printer_.update(buf);
+  }
+  void on_output(const ParticleSnapshot& s, int index) override {
+    char name[64];
+    std::snprintf(name, sizeof name, "particles_%05d.vtu", index);
+    write_vtu((out_ / "snapshots" / name).string(), s);
+    files_.emplace_back(s.time_s, std::string("snapshots/") + name);
+    write_pvd((out_ / "particles.pvd").string(), files_);
+  }
+  void finish() { printer_.finish(); }
+
+ private:
+  fs::path out_;
+  bool quiet_;
+  ProgressPrinter printer_;
+  std::vector<std::pair<double, std::string>> files_;
+};
+
+}  // namespace
+
+int run_command(const RunCommandOptions& opt) {
+  SceneConfig scene = scene_from_json(read_json_file(opt.scene_path));
+  if (opt.vtu_interval >= 0) scene.vtu_interval = opt.vtu_interval;
+  const fs::path out(opt.out_dir);
+  std::error_code ec;
+  fs::create_directories(out / "snapshots", ec);
+  if (ec) throw InputError("--out: cannot create directory " + out.string() + " (" + ec.message() + ")");
+  {
+    std::ofstream f(out / "scene_resolved.json");
+    f << scene_to_json(scene).dump(2) << "\n";
+  }
+  std::unique_ptr<tbb::global_control> threads;
+  if (opt.threads > 0)
+    threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, opt.threads);
+
+  CliObserver obs(out, opt.quiet);
+  RunSummary r = run_scene(scene, &obs);
+  obs.finish();
+  if (scene.vtu_interval > 0) obs.on_output(r.final_snapshot, 99999);
+
+  nlohmann::json summary = {
+      {"scene", scene.name},
+      {"stop_reason", r.stop_reason},
+      {"steps", r.steps},
+      {"particle_steps", r.particle_steps},
+      {"return_map_evaluations", r.return_map_evaluations},
+      {"sim_time_s", r.sim_time_s},
+      {"wall_s", r.wall_s},
+      {"particle_steps_per_s", r.wall_s > 0 ? r.particle_steps / r.wall_s : 0.0},
+      {"initial_particles", r.initial_particles},
+      {"final_particles", r.final_particles},
+      {"initial_mass", r.initial_mass},
+      {"final_mass", r.final_mass},
+      {"removed_mass", r.removed_mass},
+      {"stage_seconds", r.stage_seconds},
+      {"engine_version", CREVASSE_ENGINE_VERSION},
+  };
+  std::ofstream(out / "run_summary.json") << summary.dump(2) << "\n";
+  if (!opt.quiet) {
+    std::fprintf(stderr, "done: %s after %lld steps, t = %.1f s, wall %.1f s (%.2f M particle-steps/s) -> %s\n",
+                 r.stop_reason.c_str(), static_cast<long long>(r.steps), r.sim_time_s, r.wall_s,
+                 r.wall_s > 0 ? r.particle_steps / r.wall_s / 1e6 : 0.0, out.string().c_str());
+  }
+  return 0;
+}
+
+}  // namespace crevasse
