@@ -1,0 +1,221 @@
+#include "analysis/regime_diagram.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace crevasse::analysis {
+namespace {
+
+const Color kFitLine{0.1, 0.1, 0.1, 1.0};
+const Color kFitBand{0.35, 0.35, 0.35, 0.22};
+const Color kBreakBand{0.902, 0.624, 0.0, 0.22};  // Okabe–Ito orange, light
+const Color kFailed{0.35, 0.35, 0.35, 1.0};
+
+std::string fixed(double value, int decimals) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
+  return buffer;
+}
+
+std::string significant(double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.3g", value);
+  return buffer;
+}
+
+// "b = 0.52 [0.47, 0.57]" or "b = 1 (fixed)".
+std::string exponent_text(const std::string& name, double b, const ConfidenceInterval& ci,
+                          bool is_fixed) {
+  if (is_fixed) return name + " = " + significant(b) + " (fixed)";
+  return name + " = " + fixed(b, 2) + " [" + fixed(ci.lower, 2) + ", " + fixed(ci.upper, 2) + "]";
+}
+
+std::vector<double> log_spaced(double lo, double hi, int count) {
+  std::vector<double> x(count);
+  for (int i = 0; i < count; ++i) {
+    x[i] = lo * std::pow(hi / lo, static_cast<double>(i) / (count - 1));
+  }
+  return x;
+}
+
+// Curve and band sampled over the fitted data range, with the breakpoint itself included so
+// that the kink is drawn sharp.
+template <class Value, class Band>
+void add_fit_curve(Figure& figure, std::vector<double> x, Value&& value, Band&& band,
+                   const std::string& curve_legend) {
+  std::sort(x.begin(), x.end());
+  std::vector<double> y, lo, hi;
+  for (double xi : x) {
+    y.push_back(value(xi));
+    const ConfidenceInterval b = band(xi);
+    lo.push_back(b.lower);
+    hi.push_back(b.upper);
+  }
+  figure.add_band(x, lo, hi, kFitBand, "95 % confidence band");
+  figure.add_line(x, y, {kFitLine, 1.6, {}}, curve_legend);
+}
+
+void add_power_law(Figure& figure, const PowerLawFit& fit, const RegimeDiagramOptions& options) {
+  const PowerLaw& law = fit.law;
+  add_fit_curve(
+      figure, log_spaced(fit.x_min, fit.x_max, 120), [&](double x) { return law.value(x); },
+      [&](double x) { return law.confidence_band(x, fit.level); }, "power-law fit");
+  const TextStyle style{9.5, kFitLine, TextAnchor::right, true};
+  figure.add_text_in_axes(0.97, 0.12,
+                          options.y_label + " = " + significant(fit.a()) + " " + options.x_symbol +
+                              "^{" + fixed(fit.b(), 2) + "}",
+                          style);
+  figure.add_text_in_axes(0.97, 0.05,
+                          exponent_text("b", fit.b(), fit.ci_b, false) + ",  R^2 = " +
+                              fixed(fit.r_squared, 3) + ",  n = " + std::to_string(fit.n),
+                          style);
+}
+
+void add_broken_line(Figure& figure, const BrokenLineFit& fit,
+                     const RegimeDiagramOptions& options) {
+  const double lo = std::min(fit.segment_x_min[0], fit.segment_x_min[1]);
+  const double hi = std::max(fit.segment_x_max[0], fit.segment_x_max[1]);
+  std::vector<double> x = log_spaced(lo, hi, 160);
+  x.push_back(fit.breakpoint);
+  figure.add_vertical_band(fit.breakpoint_ci.lower, fit.breakpoint_ci.upper, kBreakBand,
+                           options.x_symbol + "^* 95 % interval");
+  figure.add_vertical_line(fit.breakpoint, {{0.70, 0.45, 0.0, 1.0}, 1.0, {4.0, 3.0}}, {});
+  // The single law, thin and dashed, shows what the second regime buys.
+  const std::vector<double> ends = log_spaced(lo, hi, 2);
+  figure.add_line(ends, {fit.single.law.value(ends[0]), fit.single.law.value(ends[1])},
+                  {{0.45, 0.45, 0.45, 1.0}, 0.9, {2.0, 2.0}}, "single power law");
+  add_fit_curve(
+      figure, x, [&](double xi) { return fit.value(xi); },
+      [&](double xi) { return fit.confidence_band(xi); }, "broken-line fit");
+
+  const TextStyle style{9.5, kFitLine, TextAnchor::right, true};
+  const std::string clipped_low = fit.breakpoint_ci_clipped_low ? "≤" : "";
+  const std::string clipped_high = fit.breakpoint_ci_clipped_high ? "≥" : "";
+  figure.add_text_in_axes(0.97, 0.19,
+                          options.x_symbol + "^* = " + significant(fit.breakpoint) + " [" +
+                              clipped_low + significant(fit.breakpoint_ci.lower) + ", " +
+                              clipped_high + significant(fit.breakpoint_ci.upper) + "]",
+                          style);
+  figure.add_text_in_axes(0.97, 0.12,
+                          exponent_text("b_1", fit.b[0], fit.ci_b[0], fit.b_fixed[0]) + ",  " +
+                              exponent_text("b_2", fit.b[1], fit.ci_b[1], fit.b_fixed[1]),
+                          style);
+  const ModelComparison& c = fit.comparison;
+  const std::string test = std::isnan(c.p_value) ? "F test n/a"
+                           : c.p_value < 0.001   ? "F test p < 0.001"
+                                                 : "F test p = " + significant(c.p_value);
+  figure.add_text_in_axes(
+      0.97, 0.05,
+      std::string(c.two_regimes_warranted ? "two regimes: " : "one regime suffices: ") + test +
+          ",  ΔAIC = " + fixed(c.aic_broken - c.aic_single, 1),
+      style);
+}
+
+}  // namespace
+
+Figure regime_diagram(const std::vector<RegimePoint>& points, const RegimeFit& fit,
+                      const RegimeDiagramOptions& options) {
+  if (points.empty() && std::holds_alternative<std::monostate>(fit)) {
+    throw std::invalid_argument("regime diagram: no points and no fit; nothing to draw");
+  }
+  Figure figure(options.width_pt, options.height_pt);
+  figure.set_title(options.title);
+  figure.set_x_axis(options.x_label, AxisScale::log10);
+  figure.set_y_axis(options.y_label, AxisScale::log10);
+  figure.set_legend_position(options.legend);
+
+  // Groups in order of first appearance, so colours follow the caller's ordering.
+  std::vector<std::string> groups;
+  for (const RegimePoint& p : points) {
+    if (std::find(groups.begin(), groups.end(), p.group) == groups.end()) groups.push_back(p.group);
+  }
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const RegimePoint& p = points[i];
+    if (!std::isfinite(p.pi) || p.pi <= 0.0 || (!p.failed && (!std::isfinite(p.y) || p.y <= 0.0))) {
+      throw std::invalid_argument("regime diagram: point " + std::to_string(i) +
+                                  " (Π = " + std::to_string(p.pi) + ", y = " + std::to_string(p.y) +
+                                  ") cannot go on log axes; mark cases without a "
+                                  "value as failed, and check Π > 0");
+    }
+  }
+
+  if (const auto* power = std::get_if<PowerLawFit>(&fit)) add_power_law(figure, *power, options);
+  if (const auto* broken = std::get_if<BrokenLineFit>(&fit))
+    add_broken_line(figure, *broken, options);
+
+  bool failed_in_legend = false;
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    std::vector<double> x, y, x_bar, lo, hi, x_failed;
+    for (const RegimePoint& p : points) {
+      if (p.group != groups[g]) continue;
+      if (p.failed) {
+        x_failed.push_back(p.pi);
+        continue;
+      }
+      x.push_back(p.pi);
+      y.push_back(p.y);
+      if (std::isfinite(p.y_q25) && std::isfinite(p.y_q75)) {
+        x_bar.push_back(p.pi);
+        lo.push_back(p.y_q25);
+        hi.push_back(p.y_q75);
+      }
+    }
+    const Color color = palette_color(g);
+    figure.add_error_bars(x_bar, lo, hi, color.with_alpha(0.8));
+    figure.add_points(x, y, {palette_marker(g), color, 6.5, true},
+                      groups[g].empty() ? "cases" : groups[g]);
+    if (!x_failed.empty()) {
+      figure.add_bottom_markers(x_failed, {MarkerShape::cross, color, 6.0, false},
+                                failed_in_legend ? "" : "failed / no crevasse");
+      failed_in_legend = true;
+    }
+  }
+  return figure;
+}
+
+Figure empirical_cdf_figure(const std::vector<NamedSample>& samples,
+                            const CdfFigureOptions& options) {
+  if (samples.empty()) {
+    throw std::invalid_argument("CDF figure: no samples given; pass at least one named sample");
+  }
+  Figure figure(options.width_pt, options.height_pt);
+  figure.set_title(options.title);
+  figure.set_x_axis(options.x_label, options.x_scale);
+  figure.set_y_axis(options.y_label, AxisScale::linear, 0.0, 1.0);
+  figure.set_legend_position(options.legend);
+  for (std::size_t s = 0; s < samples.size(); ++s) {
+    const NamedSample& sample = samples[s];
+    if (sample.values.empty()) {
+      throw std::invalid_argument("CDF figure: sample '" + sample.name +
+                                  "' is empty; drop it or give it values");
+    }
+    for (std::size_t i = 0; i < sample.values.size(); ++i) {
+      const double v = sample.values[i];
+      if (!std::isfinite(v) || (options.x_scale == AxisScale::log10 && v <= 0.0)) {
+        throw std::invalid_argument(
+            "CDF figure: sample '" + sample.name + "' value " + std::to_string(i) + " = " +
+            std::to_string(v) + (std::isfinite(v) ? " cannot go on a log axis" : " is not finite"));
+      }
+    }
+    std::vector<double> sorted = sample.values;
+    std::sort(sorted.begin(), sorted.end());
+    // F̂(x) = #{x_i ≤ x}/n as a right-continuous staircase.
+    const double n = static_cast<double>(sorted.size());
+    std::vector<double> x{sorted.front()}, y{0.0};
+    for (std::size_t i = 0; i < sorted.size(); ++i) {
+      x.push_back(sorted[i]);
+      y.push_back(static_cast<double>(i + 1) / n);
+      if (i + 1 < sorted.size()) {
+        x.push_back(sorted[i + 1]);
+        y.push_back(static_cast<double>(i + 1) / n);
+      }
+    }
+    figure.add_line(x, y, {palette_color(s), 1.6, {}},
+                    sample.name + " (n = " + std::to_string(sorted.size()) + ")");
+  }
+  return figure;
+}
+
+}  // namespace crevasse::analysis
