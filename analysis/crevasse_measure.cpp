@@ -32,8 +32,8 @@ void require_non_negative(double value, const char* field) {
 void check_arrays(const ParticleSnapshot& s) {
   const std::size_t n = s.x.size();
   require(s.dim == 2 || s.dim == 3, "snapshot dim must be 2 or 3, got " + std::to_string(s.dim));
-  require(s.z.size() == n, "snapshot z has " + std::to_string(s.z.size()) +
-                               " entries but x has " + std::to_string(n));
+  require(s.z.size() == n, "snapshot z has " + std::to_string(s.z.size()) + " entries but x has " +
+                               std::to_string(n));
   require(s.eps_v_p.size() == n, "snapshot eps_v_p has " + std::to_string(s.eps_v_p.size()) +
                                      " entries but x has " + std::to_string(n));
   if (s.dim == 3) {
@@ -89,11 +89,12 @@ ResolvedMeasureSettings resolve_measure_settings(const ParticleSnapshot& snapsho
   r.ice_thickness_m = settings.ice_thickness_m.value_or(snapshot.ice_thickness_m);
   if (has_particles) {
     require_positive(r.dx_m, "dx (snapshot dx_m or MeasureSettings::dx_m)");
-    require_positive(r.ice_thickness_m,
-                     "ice thickness H_i (snapshot ice_thickness_m or MeasureSettings::ice_thickness_m)");
+    require_positive(
+        r.ice_thickness_m,
+        "ice thickness H_i (snapshot ice_thickness_m or MeasureSettings::ice_thickness_m)");
   }
-  const double spacing_default = snapshot.particle_spacing_m > 0.0 ? snapshot.particle_spacing_m
-                                                                   : 0.5 * r.dx_m;
+  const double spacing_default =
+      snapshot.particle_spacing_m > 0.0 ? snapshot.particle_spacing_m : 0.5 * r.dx_m;
   r.particle_spacing_m = settings.particle_spacing_m.value_or(spacing_default);
   if (has_particles) {
     require_positive(r.particle_spacing_m,
@@ -169,7 +170,8 @@ CrevasseMeasurement measure_crevasses(const ParticleSnapshot& snapshot,
     damaged.push_back(criterion.is_damaged(snapshot.eps_v_p[i]) ? 1 : 0);
   }
   m.particle_count = px.size();
-  m.damaged_particle_count = static_cast<std::size_t>(std::count(damaged.begin(), damaged.end(), 1));
+  m.damaged_particle_count =
+      static_cast<std::size_t>(std::count(damaged.begin(), damaged.end(), 1));
   const bool window_has_length = r.window_max_x_m > r.window_min_x_m;
   auto in_window = [&](double x) { return x >= r.window_min_x_m && x <= r.window_max_x_m; };
 
@@ -195,9 +197,9 @@ CrevasseMeasurement measure_crevasses(const ParticleSnapshot& snapshot,
     if (!window_has_length || !in_window(px[p])) continue;
     ++m.window_particle_count;
     window_damaged += damaged[p];
-    const auto b = std::min(m.surface.size() - 1,
-                            static_cast<std::size_t>(std::max(
-                                0.0, std::floor((px[p] - m.surface.x0_m) / r.dx_m))));
+    const auto b = std::min(
+        m.surface.size() - 1,
+        static_cast<std::size_t>(std::max(0.0, std::floor((px[p] - m.surface.x0_m) / r.dx_m))));
     bin_has_any[b] = 1;
     if (!damaged[p]) bin_has_intact[b] = 1;
   }
@@ -241,8 +243,8 @@ CrevasseMeasurement measure_crevasses(const ParticleSnapshot& snapshot,
     // be bridged nor a sloping or curved surface biases the depth.
     const double x_left_lip = c.left_m - r.lip_offset_m, x_right_lip = c.right_m + r.lip_offset_m;
     const double t_lip = (c.crevasse.x_m - x_left_lip) / (x_right_lip - x_left_lip);
-    c.crevasse.surface_z_m = (1.0 - t_lip) * m.surface.height_at(x_left_lip) +
-                             t_lip * m.surface.height_at(x_right_lip);
+    c.crevasse.surface_z_m =
+        (1.0 - t_lip) * m.surface.height_at(x_left_lip) + t_lip * m.surface.height_at(x_right_lip);
     c.crevasse.bottom_z_m = t.z_min - half_spacing;
     c.crevasse.depth_m = std::max(0.0, c.crevasse.surface_z_m - c.crevasse.bottom_z_m);
     c.crevasse.particle_count = t.particle_count;

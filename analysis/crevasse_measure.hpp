@@ -57,7 +57,7 @@ struct MeasureSettings {
 // The numbers actually used, recorded with every result.
 struct ResolvedMeasureSettings {
   double damage_threshold = 0.0;
-  double eps_v_p_threshold = 0.0;       // the ε_v^p at which a particle becomes damaged
+  double eps_v_p_threshold = 0.0;         // the ε_v^p at which a particle becomes damaged
   bool threshold_from_softening = false;  // false: the absolute ε_v^p threshold was used
   double window_min_x_m = 0.0;
   double window_max_x_m = 0.0;
@@ -86,7 +86,7 @@ struct Crevasse {
   double depth_m = 0.0;      // surface_z_m − bottom_z_m
   double width_m = 0.0;      // x-extent of its damaged material near the surface
   std::size_t particle_count = 0;
-  std::size_t merged_count = 1;              // clusters merged into it by the resolution floor
+  std::size_t merged_count = 1;             // clusters merged into it by the resolution floor
   std::optional<double> spacing_to_next_m;  // absent for the most downstream crevasse
 };
 
@@ -110,7 +110,7 @@ struct CrevasseMeasurement {
   std::vector<Crevasse> crevasses;  // inside the window, sorted by x, after merging
   std::vector<double> spacings_m;   // between consecutive crevasses, all ≥ the floor
   std::size_t dropped_spacing_count = 0;
-  std::size_t particle_count = 0;          // particles measured (the band, in 3D)
+  std::size_t particle_count = 0;  // particles measured (the band, in 3D)
   std::size_t window_particle_count = 0;
   std::size_t damaged_particle_count = 0;  // of the measured particles
   std::size_t cluster_count = 0;           // damaged clusters anywhere, crevasse or not

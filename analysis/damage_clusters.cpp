@@ -78,6 +78,12 @@ DamageClusters find_damage_clusters(std::span<const double> x, std::span<const d
 
   const double link2 = link_distance_m * link_distance_m;
   DisjointSets sets(members.size());
+  // i, j: positions in the cell-sorted order.
+  auto link_if_close = [&](std::size_t i, std::size_t j) {
+    const auto a = members[order[i]], b = members[order[j]];
+    const double ddx = x[a] - x[b], ddz = z[a] - z[b];
+    if (ddx * ddx + ddz * ddz <= link2) sets.unite(order[i], order[j]);
+  };
   // Each unordered pair of cells is visited once: the cell itself and four forward neighbours.
   constexpr int kForward[4][2] = {{0, 1}, {1, -1}, {1, 0}, {1, 1}};
   std::size_t begin = 0;
@@ -85,26 +91,19 @@ DamageClusters find_damage_clusters(std::span<const double> x, std::span<const d
     std::size_t end = begin;
     while (end < order.size() && sorted_key[end] == sorted_key[begin]) ++end;
     for (std::size_t i = begin; i < end; ++i) {
-      for (std::size_t j = i + 1; j < end; ++j) {
-        const auto a = members[order[i]], b = members[order[j]];
-        const double ddx = x[a] - x[b], ddz = z[a] - z[b];
-        if (ddx * ddx + ddz * ddz <= link2) sets.unite(order[i], order[j]);
-      }
+      for (std::size_t j = i + 1; j < end; ++j) link_if_close(i, j);
     }
     const auto ix = static_cast<std::int64_t>(sorted_key[begin] >> 32);
     const auto iz = static_cast<std::int64_t>(sorted_key[begin] & 0xffffffffu);
     for (const auto& d : kForward) {
       const std::int64_t nx = ix + d[0], nz = iz + d[1];
       if (nz < 0) continue;
-      const std::uint64_t nk = (static_cast<std::uint64_t>(nx) << 32) | static_cast<std::uint64_t>(nz);
+      const std::uint64_t nk =
+          (static_cast<std::uint64_t>(nx) << 32) | static_cast<std::uint64_t>(nz);
       auto lo = std::lower_bound(sorted_key.begin(), sorted_key.end(), nk);
       for (auto it = lo; it != sorted_key.end() && *it == nk; ++it) {
         const auto j = static_cast<std::size_t>(it - sorted_key.begin());
-        for (std::size_t i = begin; i < end; ++i) {
-          const auto a = members[order[i]], b = members[order[j]];
-          const double ddx = x[a] - x[b], ddz = z[a] - z[b];
-          if (ddx * ddx + ddz * ddz <= link2) sets.unite(order[i], order[j]);
-        }
+        for (std::size_t i = begin; i < end; ++i) link_if_close(i, j);
       }
     }
     begin = end;

@@ -9,8 +9,9 @@ namespace crevasse::analysis {
 DamageCriterion::DamageCriterion(double softening_zeta, double damage_threshold,
                                  double eps_v_p_threshold) {
   if (!(damage_threshold > 0.0 && damage_threshold < 1.0)) {
-    throw std::invalid_argument("damage threshold must lie in (0, 1) (fraction of strength lost), got " +
-                                std::to_string(damage_threshold));
+    throw std::invalid_argument(
+        "damage threshold must lie in (0, 1) (fraction of strength lost), got " +
+        std::to_string(damage_threshold));
   }
   if (!(softening_zeta >= 0.0) || !std::isfinite(softening_zeta)) {
     throw std::invalid_argument("softening zeta must be finite and >= 0, got " +

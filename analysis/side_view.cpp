@@ -47,7 +47,9 @@ Rgb damage_colour(double level) {
 }
 
 std::uint32_t argb(Rgb c) {
-  auto byte = [](double v) { return static_cast<std::uint32_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0)); };
+  auto byte = [](double v) {
+    return static_cast<std::uint32_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
+  };
   return 0xff000000u | (byte(c.r) << 16) | (byte(c.g) << 8) | byte(c.b);
 }
 
@@ -110,8 +112,7 @@ void draw_bed_outline(cairo_t* cr, const Frame& f, const ParticleSnapshot& s) {
 // spacings) stays visible. A pixel shows the most damaged particle on it, so a
 // one-particle-wide crack is never painted over by intact ice.
 void paint_particles(cairo_surface_t* surface, const Frame& f, const ParticleSnapshot& s,
-                     const DamageCriterion& criterion, const SideViewOptions& o,
-                     double y_centre) {
+                     const DamageCriterion& criterion, const SideViewOptions& o, double y_centre) {
   const int w = cairo_image_surface_get_width(surface);
   const int h = cairo_image_surface_get_height(surface);
   const int stride = cairo_image_surface_get_stride(surface) / 4;
@@ -186,7 +187,8 @@ void draw_marks(cairo_t* cr, const Frame& f, const CrevasseMeasurement& m) {
   if (m.crevasses.empty()) return;
   double min_gap_px = 1e9;
   for (std::size_t i = 1; i < m.crevasses.size(); ++i) {
-    min_gap_px = std::min(min_gap_px, (m.crevasses[i].x_m - m.crevasses[i - 1].x_m) * f.scale_px_per_m);
+    min_gap_px =
+        std::min(min_gap_px, (m.crevasses[i].x_m - m.crevasses[i - 1].x_m) * f.scale_px_per_m);
   }
   // Label every k-th crevasse so that numbers never overlap.
   const auto label_every = static_cast<std::size_t>(std::max(1.0, std::ceil(22.0 / min_gap_px)));
@@ -264,7 +266,8 @@ SideViewImageSize write_side_view_png(const ParticleSnapshot& s, const std::file
   if (s.size() == 0) throw std::invalid_argument("side view: the snapshot has no particles");
   if (s.z.size() != s.size() || s.eps_v_p.size() != s.size() ||
       (s.dim == 3 && s.y.size() != s.size())) {
-    throw std::invalid_argument("side view: snapshot arrays x, z, eps_v_p (and y in 3D) differ in length");
+    throw std::invalid_argument(
+        "side view: snapshot arrays x, z, eps_v_p (and y in 3D) differ in length");
   }
   if (o.width_px < 200 || o.width_px > 16000) {
     throw std::invalid_argument("side view: width_px must lie in [200, 16000], got " +
@@ -283,7 +286,8 @@ SideViewImageSize write_side_view_png(const ParticleSnapshot& s, const std::file
       y_hi = std::max(y_hi, s.y[i]);
     }
   }
-  const double h_i = s.ice_thickness_m > 0.0 ? s.ice_thickness_m : std::max(1.0, 0.05 * (x_hi - x_lo));
+  const double h_i =
+      s.ice_thickness_m > 0.0 ? s.ice_thickness_m : std::max(1.0, 0.05 * (x_hi - x_lo));
   const double x0 = o.x_min_m.value_or(x_lo - 0.25 * h_i);
   const double x1 = o.x_max_m.value_or(x_hi + 0.25 * h_i);
   if (!(x1 > x0)) {
@@ -319,9 +323,9 @@ SideViewImageSize write_side_view_png(const ParticleSnapshot& s, const std::file
   }
   const Frame frame{x0, z1, scale, kLeft, top_margin, plot_w, plot_h};
 
-  SurfacePtr surface(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, o.width_px,
-                                                static_cast<int>(height)),
-                     cairo_surface_destroy);
+  SurfacePtr surface(
+      cairo_image_surface_create(CAIRO_FORMAT_ARGB32, o.width_px, static_cast<int>(height)),
+      cairo_surface_destroy);
   ContextPtr cr(cairo_create(surface.get()), cairo_destroy);
   if (cairo_status(cr.get()) != CAIRO_STATUS_SUCCESS) {
     throw std::runtime_error("side view: cairo could not create a " + std::to_string(o.width_px) +
@@ -346,8 +350,8 @@ SideViewImageSize write_side_view_png(const ParticleSnapshot& s, const std::file
 
   const cairo_status_t status = cairo_surface_write_to_png(surface.get(), path.c_str());
   if (status != CAIRO_STATUS_SUCCESS) {
-    throw std::runtime_error("side view: cannot write PNG '" + path.string() +
-                             "': " + cairo_status_to_string(status) + " (does the directory exist?)");
+    throw std::runtime_error("side view: cannot write PNG '" + path.string() + "': " +
+                             cairo_status_to_string(status) + " (does the directory exist?)");
   }
   return {o.width_px, static_cast<int>(height)};
 }

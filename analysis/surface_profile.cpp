@@ -25,8 +25,8 @@ namespace {
 constexpr double kMissing = -std::numeric_limits<double>::infinity();
 
 // Highest particle per bin, among those for which `use` is true.
-std::vector<double> top_per_bin(std::span<const double> x, std::span<const double> z,
-                                double x0, double width, std::size_t n_bins, auto use) {
+std::vector<double> top_per_bin(std::span<const double> x, std::span<const double> z, double x0,
+                                double width, std::size_t n_bins, auto use) {
   std::vector<double> top(n_bins, kMissing);
   for (std::size_t p = 0; p < x.size(); ++p) {
     if (!use(p)) continue;
@@ -100,8 +100,8 @@ SurfaceProfile compute_surface_profile(std::span<const double> x, std::span<cons
                                        const SurfaceSettings& settings) {
   if (x.size() != z.size() || x.size() != damaged.size()) {
     throw std::invalid_argument("surface profile: x, z and damage arrays differ in length (" +
-                                std::to_string(x.size()) + ", " + std::to_string(z.size()) +
-                                ", " + std::to_string(damaged.size()) + ")");
+                                std::to_string(x.size()) + ", " + std::to_string(z.size()) + ", " +
+                                std::to_string(damaged.size()) + ")");
   }
   if (!(settings.bin_width_m > 0.0) || !std::isfinite(settings.bin_width_m)) {
     throw std::invalid_argument("surface profile: bin width must be > 0 m (set it to dx), got " +
@@ -113,15 +113,15 @@ SurfaceProfile compute_surface_profile(std::span<const double> x, std::span<cons
 
   const auto [x_lo, x_hi] = std::minmax_element(x.begin(), x.end());
   profile.x0_m = std::floor(*x_lo / settings.bin_width_m) * settings.bin_width_m;
-  const auto n_bins = static_cast<std::size_t>(
-      std::floor((*x_hi - profile.x0_m) / settings.bin_width_m) + 1.0);
+  const auto n_bins =
+      static_cast<std::size_t>(std::floor((*x_hi - profile.x0_m) / settings.bin_width_m) + 1.0);
 
   const bool any_intact = std::find(damaged.begin(), damaged.end(), 0) != damaged.end();
-  std::vector<double> top =
-      any_intact ? top_per_bin(x, z, profile.x0_m, settings.bin_width_m, n_bins,
-                               [&](std::size_t p) { return damaged[p] == 0; })
-                 : top_per_bin(x, z, profile.x0_m, settings.bin_width_m, n_bins,
-                               [](std::size_t) { return true; });
+  std::vector<double> top = any_intact
+                                ? top_per_bin(x, z, profile.x0_m, settings.bin_width_m, n_bins,
+                                              [&](std::size_t p) { return damaged[p] == 0; })
+                                : top_per_bin(x, z, profile.x0_m, settings.bin_width_m, n_bins,
+                                              [](std::size_t) { return true; });
   profile.measured.resize(n_bins);
   for (std::size_t i = 0; i < n_bins; ++i) profile.measured[i] = top[i] != kMissing ? 1 : 0;
 

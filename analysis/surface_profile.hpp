@@ -30,7 +30,9 @@ struct SurfaceProfile {
 
   bool empty() const { return z_m.empty(); }
   std::size_t size() const { return z_m.size(); }
-  double bin_center_x(std::size_t i) const { return x0_m + (static_cast<double>(i) + 0.5) * bin_width_m; }
+  double bin_center_x(std::size_t i) const {
+    return x0_m + (static_cast<double>(i) + 0.5) * bin_width_m;
+  }
   // z_s(x) by linear interpolation between bin centres, held constant past the ends.
   double height_at(double x_m) const;
 };

@@ -124,8 +124,9 @@ TEST(MeasureIntact, SlabWithoutDamageHasNoCrevasse) {
 TEST(MeasureBuried, DamageThatDoesNotReachTheSurfaceIsNotACrevasse) {
   SlabSpec spec;
   // Buried 30 m below the surface: beyond the 1.5·dx = 15 m reach.
-  const std::vector<Notch> notches = {{.x_m = 500.0, .depth_m = 80.0, .width_m = 20.0, .top_gap_m = 30.0},
-                                      {.x_m = 900.0, .depth_m = 50.0}};
+  const std::vector<Notch> notches = {
+      {.x_m = 500.0, .depth_m = 80.0, .width_m = 20.0, .top_gap_m = 30.0},
+      {.x_m = 900.0, .depth_m = 50.0}};
   const CrevasseMeasurement m = measure_crevasses(make_slab(spec, notches));
   EXPECT_EQ(m.cluster_count, 2u);
   ASSERT_EQ(m.crevasses.size(), 1u);
@@ -181,7 +182,9 @@ TEST(MeasureCurved, DepthIsRelativeToTheLocalSurfaceOnACurvedSurface) {
 TEST(MeasureCurved, DepthFollowsTheSurfaceOfIceDraggedOverARamp) {
   // Piecewise-linear draping: plateau, ramp of slope 0.3, floor (sharp bends).
   SlabSpec spec{.x_max_m = 2000.0, .noise_over_spacing = 0.1};
-  spec.base_z = [](double x) { return x < 600.0 ? 90.0 : (x < 900.0 ? 90.0 - 0.3 * (x - 600.0) : 0.0); };
+  spec.base_z = [](double x) {
+    return x < 600.0 ? 90.0 : (x < 900.0 ? 90.0 - 0.3 * (x - 600.0) : 0.0);
+  };
   const auto notches = notch_train(spec, 70.0, {30.0, 50.0});
   const CrevasseMeasurement m = measure_crevasses(make_slab(spec, notches));
   // One cell. At the concave bend the bridge can lift the lips by up to slope change ×
@@ -204,7 +207,8 @@ TEST(MeasureFragmented, MostlyDamagedWindowIsFlagged) {
   SlabSpec spec{.x_max_m = 1000.0};
   // Damaged columns 15 m wide every 20 m: three quarters of the ice is broken.
   std::vector<Notch> notches;
-  for (double x = 100.0; x < 1000.0; x += 20.0) notches.push_back({.x_m = x, .depth_m = 100.0, .width_m = 15.0});
+  for (double x = 100.0; x < 1000.0; x += 20.0)
+    notches.push_back({.x_m = x, .depth_m = 100.0, .width_m = 15.0});
   const CrevasseMeasurement m = measure_crevasses(make_slab(spec, notches));
   EXPECT_TRUE(m.flags.fragmented);
   expect_measurement_finite(m);
@@ -271,7 +275,8 @@ TEST(MeasureInvalid, InconsistentSnapshotThrowsWithTheField) {
 
 TEST(MeasureThreshold, WithoutSofteningTheAbsoluteThresholdApplies) {
   SlabSpec spec{.softening_zeta = 0.0, .notch_eps_v_p = 0.02};
-  const std::vector<Notch> notches = {{.x_m = 400.0, .depth_m = 40.0}, {.x_m = 600.0, .depth_m = 40.0}};
+  const std::vector<Notch> notches = {{.x_m = 400.0, .depth_m = 40.0},
+                                      {.x_m = 600.0, .depth_m = 40.0}};
   const auto slab = make_slab(spec, notches);
   const CrevasseMeasurement m = measure_crevasses(slab);  // default threshold 0.01 < 0.02
   EXPECT_EQ(m.crevasses.size(), 2u);

@@ -37,10 +37,13 @@ PngSize read_png_size(const std::filesystem::path& path) {
 // Ice draped over a 60 m ramp, with crevasses of several depths downstream.
 ParticleSnapshot draped_slab(int dim) {
   SlabSpec spec{.dim = dim, .x_max_m = 2000.0, .width_m = 20.0, .noise_over_spacing = 0.15};
-  spec.base_z = [](double x) { return x < 500.0 ? 60.0 : (x < 700.0 ? 60.0 - 0.3 * (x - 500.0) : 0.0); };
+  spec.base_z = [](double x) {
+    return x < 500.0 ? 60.0 : (x < 700.0 ? 60.0 - 0.3 * (x - 500.0) : 0.0);
+  };
   std::vector<Notch> notches;
   int k = 0;
-  for (double x = 760.0; x < 1900.0; x += 70.0, ++k) notches.push_back({.x_m = x, .depth_m = 25.0 + 10.0 * (k % 4)});
+  for (double x = 760.0; x < 1900.0; x += 70.0, ++k)
+    notches.push_back({.x_m = x, .depth_m = 25.0 + 10.0 * (k % 4)});
   auto s = make_slab(spec, notches);
   s.step_top_x_m = 500.0;
   s.step_foot_x_m = 700.0;
@@ -51,7 +54,8 @@ class SideViewTest : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = std::filesystem::temp_directory_path() /
-           ("crevasse_side_view_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+           ("crevasse_side_view_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     std::filesystem::create_directories(dir_);
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
@@ -109,7 +113,8 @@ TEST_F(SideViewTest, DamagedParticlesAreDrawnDark) {
   const int stride = cairo_image_surface_get_stride(img) / 4;
   const auto* px = reinterpret_cast<const std::uint32_t*>(cairo_image_surface_get_data(img));
   const double scale = (800.0 - 90.0) / 400.0;
-  const int row = static_cast<int>(12.0 + (100.0 + 15.0 + 28.0 / scale - 50.0) * scale);  // z = 50 m
+  const int row =
+      static_cast<int>(12.0 + (100.0 + 15.0 + 28.0 / scale - 50.0) * scale);  // z = 50 m
   auto brightness = [&](double x_m) {
     const std::uint32_t p = px[row * stride + static_cast<int>(70.0 + x_m * scale)];
     return ((p >> 16) & 0xff) + ((p >> 8) & 0xff) + (p & 0xff);
@@ -135,7 +140,8 @@ TEST_F(SideViewTest, BadInputsThrowActionableErrors) {
   SideViewOptions inverted;
   inverted.x_min_m = 500.0;
   inverted.x_max_m = 100.0;
-  EXPECT_THROW(write_side_view_png(draped_slab(2), dir_ / "x.png", inverted), std::invalid_argument);
+  EXPECT_THROW(write_side_view_png(draped_slab(2), dir_ / "x.png", inverted),
+               std::invalid_argument);
   EXPECT_THROW(write_side_view_png(draped_slab(2), "/nonexistent-dir/x.png"), std::runtime_error);
 }
 
