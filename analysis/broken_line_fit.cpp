@@ -201,7 +201,7 @@ BrokenLineFit fit_broken_line(std::span<const double> x, std::span<const double>
   fit.b_fixed = {options.fixed_b1.has_value(), options.fixed_b2.has_value()};
 
   // Profile-likelihood interval for u*: all u* whose profile RSS stays below
-  // RSS_min·(1 + F_{1,n−p}(level)/(n−p)) (Bates & Watts 1988, §6.1; Seber & Wild 2003, §9.3).
+  // RSS_min·(1 + F_{1,n−p}(level)/(n−p)) (Bates & Watts 1988, ch. 6; Hinkley 1969).
   // The hull over the grid is taken, so a profile with several dips gives a wider interval.
   const double threshold =
       solution.rss * (1.0 + gsl_cdf_fdist_Pinv(options.level, 1.0, fit.dof) / fit.dof);
@@ -238,7 +238,7 @@ BrokenLineFit fit_broken_line(std::span<const double> x, std::span<const double>
   fit.breakpoint_ci = {std::exp(std::min(ci_lo, u_star)), std::exp(std::max(ci_hi, u_star))};
 
   // Linearised covariance of the free parameters, s²(JᵀJ)⁻¹, with J the Jacobian of the
-  // model in (α, b1, b2, u*) (Seber & Wild 2003, §9.3.2; Muggeo 2003).
+  // model in (α, b1, b2, u*) (Seber & Wild 2003, ch. 9; Muggeo 2003).
   std::vector<int> free_index{kAlpha};
   if (!fit.b_fixed[0]) free_index.push_back(kB1);
   if (!fit.b_fixed[1]) free_index.push_back(kB2);
@@ -316,7 +316,7 @@ BrokenLineFit fit_broken_line(std::span<const double> x, std::span<const double>
   }
 
   // Model comparison with one power law on the same rows (extra sum of squares F test;
-  // Seber & Wild 2003, §5.3; AIC: Burnham & Anderson 2002).
+  // Draper & Smith 1998; AIC: Burnham & Anderson 2002).
   fit.single = fit_power_law(x, y, options.level);
   ModelComparison& comparison = fit.comparison;
   comparison.rss_single = fit.single.rss;

@@ -76,7 +76,8 @@ PowerLawFit fit_power_law(std::span<const double> x, std::span<const double> y,
                           double level = 0.95);
 
 // Gaussian-likelihood AIC of a least-squares fit: n·ln(rss/n) + 2·(parameters + 1), the +1
-// being σ² (Burnham & Anderson 2002, §2.2). A perfect fit (rss = 0) is clamped to a tiny rss.
+// being σ² (Akaike 1974; Burnham & Anderson 2002). A perfect fit (rss = 0) is clamped to a tiny
+// rss.
 double least_squares_aic(double rss, std::size_t n, std::size_t parameters);
 
 }  // namespace crevasse::analysis
