@@ -192,6 +192,37 @@ TEST(MeasureCurved, DepthFollowsTheSurfaceOfIceDraggedOverARamp) {
   expect_matches(m, notches, spec.dx_m);
 }
 
+TEST(MeasureOpen, WideOpenCrevasseIsMeasuredFromItsLips) {
+  // A V-shaped opening 60 m wide at the surface (wider than the ±25 m bridge) down to a tip
+  // 60 m deep: no particles in the gap, damaged walls one spacing thick, intact ice below. Inside
+  // the gap the "highest undamaged particle" surface drops to the tip; the lips do not.
+  SlabSpec spec{.x_max_m = 1000.0};
+  ParticleSnapshot slab = make_slab(spec, {});
+  const double h = test::spacing_of(spec), x_c = 500.0, z_tip = 40.0, half_top = 30.0;
+  auto gap_half_width = [&](double z) { return half_top * (z - z_tip) / (100.0 - z_tip); };
+  ParticleSnapshot open = slab;
+  open.x.clear();
+  open.z.clear();
+  open.eps_v_p.clear();
+  double z_lowest_damaged = 1e9;
+  for (std::size_t i = 0; i < slab.size(); ++i) {
+    const double d = std::abs(slab.x[i] - x_c) - gap_half_width(slab.z[i]);
+    if (slab.z[i] > z_tip && d < 0.0) continue;  // inside the opening
+    const bool wall = slab.z[i] > z_tip - 1.5 * h && d < 1.2 * h;
+    if (wall) z_lowest_damaged = std::min(z_lowest_damaged, slab.z[i]);
+    open.x.push_back(slab.x[i]);
+    open.z.push_back(slab.z[i]);
+    open.eps_v_p.push_back(wall ? spec.notch_eps_v_p : 0.0);
+  }
+  const CrevasseMeasurement m = measure_crevasses(open);
+  ASSERT_EQ(m.crevasses.size(), 1u);
+  // One cell: the walls are resolved on the lattice.
+  EXPECT_NEAR(m.crevasses[0].x_m, x_c, spec.dx_m);
+  EXPECT_NEAR(m.crevasses[0].surface_z_m, 100.0, spec.dx_m);
+  EXPECT_NEAR(m.crevasses[0].depth_m, 100.0 - (z_lowest_damaged - 0.5 * h), spec.dx_m);
+  EXPECT_GT(m.crevasses[0].width_m, 2.0 * half_top);
+}
+
 TEST(MeasureFragmented, FullyDamagedSlabIsFlaggedAndFinite) {
   SlabSpec spec{.x_max_m = 1000.0};
   const CrevasseMeasurement m = measure_crevasses(
