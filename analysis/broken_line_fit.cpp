@@ -105,6 +105,21 @@ double threshold_crossing(F&& rss, double inside, double outside, double thresho
   return 0.5 * (inside + outside);
 }
 
+// gᵀ C h for the 4×4 row-major covariance. Infinite entries belong to an unidentified u*
+// (equal slopes), whose shift is absorbed by α: leaving them out gives the result conditional
+// on u*, which is what the curve and the segment laws then depend on.
+double covariance_form(const std::array<double, 4>& g, const std::array<double, 16>& covariance,
+                       const std::array<double, 4>& h) {
+  double sum = 0.0;
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 4; ++j) {
+      const double c = covariance[4 * i + j];
+      if (std::isfinite(c) && g[i] != 0.0 && h[j] != 0.0) sum += g[i] * c * h[j];
+    }
+  }
+  return sum;
+}
+
 }  // namespace
 
 double BrokenLineFit::value(double x) const {
@@ -118,9 +133,7 @@ ConfidenceInterval BrokenLineFit::confidence_band(double x) const {
   // Gradient of ln ŷ(u) with respect to (α, b1, b2, u*).
   const std::array<double, 4> gradient{1.0, std::min(u - u_star, 0.0), std::max(u - u_star, 0.0),
                                        u < u_star ? -b[0] : -b[1]};
-  double variance = 0.0;
-  for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 4; ++j) variance += gradient[i] * covariance[4 * i + j] * gradient[j];
+  const double variance = covariance_form(gradient, covariance, gradient);
   const double half = student_t_quantile(level, dof) * std::sqrt(std::max(variance, 0.0));
   const double centre = std::log(value(x));
   return {std::exp(centre - half), std::exp(centre + half)};
@@ -259,9 +272,10 @@ BrokenLineFit fit_broken_line(std::span<const double> x, std::span<const double>
   if (lu.isInvertible()) {
     free_covariance = fit.residual_variance * lu.inverse();
   } else {
+    // The linear block is invertible: admissibility puts two distinct x on each side.
     const Eigen::MatrixXd conditional = information.topLeftCorner(k - 1, k - 1);
     free_covariance.topLeftCorner(k - 1, k - 1) =
-        fit.residual_variance * conditional.completeOrthogonalDecomposition().pseudoInverse();
+        fit.residual_variance * conditional.fullPivLu().inverse();
     free_covariance(k - 1, k - 1) = std::numeric_limits<double>::infinity();
   }
   for (int r = 0; r < k; ++r)
@@ -281,15 +295,10 @@ BrokenLineFit fit_broken_line(std::span<const double> x, std::span<const double>
     grad_log_a[kAlpha] = 1.0;
     grad_log_a[slope_index] = -u_star;
     grad_log_a[kBreak] = -fit.b[s];
-    double var_log_a = 0.0, cov_log_a_b = 0.0;
-    for (int i = 0; i < 4; ++i) {
-      cov_log_a_b += grad_log_a[i] * cov(i, slope_index);
-      for (int j = 0; j < 4; ++j) {
-        // 0·∞ from an unidentified u* must not poison the sum.
-        if (grad_log_a[i] != 0.0 && grad_log_a[j] != 0.0)
-          var_log_a += grad_log_a[i] * cov(i, j) * grad_log_a[j];
-      }
-    }
+    std::array<double, 4> grad_b{0.0, 0.0, 0.0, 0.0};
+    grad_b[slope_index] = 1.0;
+    const double var_log_a = covariance_form(grad_log_a, fit.covariance, grad_log_a);
+    const double cov_log_a_b = covariance_form(grad_log_a, fit.covariance, grad_b);
     PowerLaw& law = fit.segments[s];
     law.log_a = solution.alpha - fit.b[s] * u_star;
     law.b = fit.b[s];
@@ -331,8 +340,11 @@ BrokenLineFit fit_broken_line(std::span<const double> x, std::span<const double>
     const double rss_broken = std::max(comparison.rss_broken, std::numeric_limits<double>::min());
     comparison.f_statistic =
         (reduction / comparison.df_numerator) / (rss_broken / comparison.df_denominator);
-    comparison.p_value =
-        gsl_cdf_fdist_Q(comparison.f_statistic, comparison.df_numerator, comparison.df_denominator);
+    // An exact broken-line fit overflows F; GSL's default handler would abort on infinity.
+    comparison.p_value = std::isfinite(comparison.f_statistic)
+                             ? gsl_cdf_fdist_Q(comparison.f_statistic, comparison.df_numerator,
+                                               comparison.df_denominator)
+                             : 0.0;
     comparison.two_regimes_warranted = comparison.p_value < 0.05 && aic_prefers_broken;
   } else {
     comparison.f_statistic = std::numeric_limits<double>::quiet_NaN();

@@ -144,6 +144,21 @@ TEST(FitBrokenLine, FixedExponentsAreHonoured) {
   EXPECT_TRUE(both.comparison.two_regimes_warranted);
 }
 
+TEST(FitBrokenLine, ExactSingleLawLeavesTheBreakpointFreeButTheCurveExact) {
+  // y = 2x exactly: both slopes are 1, so u* is not identifiable (any u* fits) while the curve
+  // itself is exact; the band must stay finite and collapse onto it, and one regime suffices.
+  const std::vector<double> x{1, 2, 3, 4, 5, 6, 7, 8};
+  std::vector<double> y;
+  for (double xi : x) y.push_back(2.0 * xi);
+  const BrokenLineFit fit = fit_broken_line(x, y);
+  EXPECT_NEAR(fit.b[0], 1.0, 1e-9);  // exact data: round-off only
+  EXPECT_NEAR(fit.b[1], 1.0, 1e-9);
+  EXPECT_FALSE(fit.comparison.two_regimes_warranted);
+  const ConfidenceInterval band = fit.confidence_band(3.0);
+  EXPECT_NEAR(band.lower, 6.0, 1e-6);
+  EXPECT_NEAR(band.upper, 6.0, 1e-6);
+}
+
 TEST(FitBrokenLine, DegenerateInputsAreRejectedClearly) {
   const auto expect_message = [](const std::vector<double>& x, const std::vector<double>& y,
                                  const std::string& phrase) {
