@@ -20,6 +20,9 @@ struct Particles {
   std::vector<double> mass;     // [kg] (per unit depth in 2D)
   std::vector<double> vol0;     // reference volume [m^Dim]
   std::vector<double> eps_v_p;  // ε_v^p = ln J_P [-]; empty without plasticity
+  // Drive: initial x of the particles of the pushed back layer, NaN for the others; empty
+  // without the drive effect.
+  std::vector<double> drive_x0;
 
   std::size_t size() const { return x.size(); }
   bool has_plastic_state() const { return !eps_v_p.empty(); }
@@ -39,6 +42,7 @@ struct Particles {
     apply(x, order); apply(v, order); apply(C, order); apply(F_e, order); apply(tau, order);
     apply(mass, order); apply(vol0, order);
     if (has_plastic_state()) apply(eps_v_p, order);
+    if (!drive_x0.empty()) apply(drive_x0, order);
   }
 
   // Keeps the particles with keep[i] true, in order; returns the mass removed.

@@ -201,6 +201,11 @@ void SceneConfig::resolve() {
     softening_zeta = 0.0;
   }
 
+  if (settle_time < 0.0) {
+    const double h = body == "slab" ? ice_thickness : box_max[dim - 1] - box_min[dim - 1];
+    settle_time = (initial_stress == "geostatic" && has(Effect::gravity)) ? 30.0 * h / p_wave_speed() : 0.0;
+  }
+  check_range("ice.settle_time", settle_time, 0.0, 1e6);
   if (body == "slab") {
     check_range("ice.thickness", ice_thickness, 0.0, 1e5, true);
     if (dx > ice_thickness / 4.0)
@@ -210,7 +215,7 @@ void SceneConfig::resolve() {
     if (downstream_length == 0.0) downstream_length = 10.0 * ice_thickness;
     if (width == 0.0) width = ice_thickness;
     if (top_margin == 0.0) top_margin = 0.5 * ice_thickness + 4.0 * dx;
-    if (drive_ramp_time == 0.0 && has(Effect::drive)) drive_ramp_time = 10.0 * upstream_length / p_wave_speed();
+    if (drive_ramp_time == 0.0 && has(Effect::drive)) drive_ramp_time = 100.0 * upstream_length / p_wave_speed();
     check_range("ice.upstream_length", upstream_length, 2.0 * dx, 1e7);
     check_range("bed.downstream_length", downstream_length, 4.0 * dx, 1e7);
     check_range("ice.width", width, 2.0 * dx, 1e6);
@@ -276,6 +281,7 @@ SceneConfig scene_from_json(const nlohmann::json& j) {
     o.vector3("box_min", s.box_min, s.dim);
     o.vector3("box_max", s.box_max, s.dim);
     o.string("initial_stress", s.initial_stress);
+    o.number("settle_time", s.settle_time);
     if (const auto* soft = o.child("softening")) {
       ObjectReader so(*soft, "ice.softening");
       so.number("zeta_ref", s.zeta_ref);
@@ -391,6 +397,7 @@ nlohmann::json scene_to_json(const SceneConfig& s) {
         {"upstream_length", s.upstream_length},
         {"width", s.width},
         {"initial_stress", s.initial_stress},
+        {"settle_time", s.settle_time},
         {"softening",
          {{"zeta_ref", s.zeta_ref},
           {"dx_ref", s.dx_ref},

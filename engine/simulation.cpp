@@ -75,7 +75,6 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   add_stage("p2g", [this] { particle_to_grid(); });
   add_stage(g != 0.0 ? "grid_velocity_gravity" : "grid_velocity",
             [this, gravity] { grid_velocity(gravity); });
-  if (scene_.has(Effect::drive)) add_stage("drive", [this] { apply_drive_to_grid(); });
   if (scene_.has(Effect::basal_friction))
     add_stage("basal_friction", [this] { apply_bed_friction_to_grid(); });
   if (scene_.has(Effect::lateral_walls)) {
@@ -90,18 +89,28 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   }
   if (scene_.has(Effect::velocity_boundaries))
     add_stage("velocity_boundaries", [this] { apply_velocity_boxes_to_grid(); });
+  if (scene_.settle_time > 0.0) {
+    // Damping exists only while settling: one branch per step, none per particle.
+    settle_damping_rate_ = scene_.p_wave_speed() /
+                           (scene_.body == "slab" ? scene_.ice_thickness
+                                                  : scene_.box_max[Dim - 1] - scene_.box_min[Dim - 1]);
+    add_stage("settle_damping", [this] {
+      if (!settling_) return;
+      const double f = std::exp(-settle_damping_rate_ * dt_);
+      for (auto& v : grid_.vel) v *= f;
+    });
+  }
   if (scene_.has(Effect::plasticity)) {
-    add_stage("g2p_return_mapping", [this] { grid_to_particle<true>(); });
+    add_stage("g2p_return_mapping", [this] {
+      if (settling_) grid_to_particle<false>();
+      else grid_to_particle<true>();
+    });
   } else {
     add_stage("g2p_elastic", [this] { grid_to_particle<false>(); });
   }
   if (scene_.has(Effect::basal_friction))
     add_stage("bed_projection", [this] { project_particles_out_of_bed(); });
-  if (scene_.has(Effect::drive)) {
-    add_stage("drive_clamp", [this] {
-      clamp_particles(0, scene_.drive_position(time_), domain_hi_[0]);
-    });
-  }
+  if (scene_.has(Effect::drive)) add_stage("drive", [this] { drive_back_layer(); });
   // Particles never leave the domain: the last line of defence, whatever the effects.
   add_stage("domain_clamp", [this] {
     for (int a = 0; a < Dim; ++a) clamp_particles(a, domain_lo_[a], domain_hi_[a]);
@@ -237,10 +246,36 @@ void Simulation<Dim>::seed_particles() {
     particles_.push_back(pos, rho * cell_volume, vol0, fe, tau);
   }
   if (scene_.has(Effect::plasticity)) particles_.eps_v_p.assign(particles_.size(), 0.0);
+  if (scene_.has(Effect::drive)) {
+    particles_.drive_x0.assign(particles_.size(), std::numeric_limits<double>::quiet_NaN());
+    for (std::size_t p = 0; p < particles_.size(); ++p)
+      if (particles_.x[p][0] < lo[0] + dx) particles_.drive_x0[p] = particles_.x[p][0];
+  }
+}
+
+template <int Dim>
+void Simulation<Dim>::settle() {
+  if (settled_) return;
+  settled_ = true;
+  if (scene_.settle_time <= 0.0) return;
+  settling_ = true;
+  while (time_ < scene_.settle_time) step();
+  settling_ = false;
+  for (std::size_t p = 0; p < particles_.size(); ++p) {
+    particles_.v[p].setZero();
+    particles_.C[p].setZero();
+  }
+  time_ = 0.0;
+  steps_ = 0;
+  particle_steps_ = 0;
+  return_map_evaluations_ = 0;
+  for (auto& st : stages_) st = {st.name, 0, 0.0};
+  update_time_step();
 }
 
 template <int Dim>
 void Simulation<Dim>::step() {
+  if (!settled_) settle();
   for (std::size_t s = 0; s < stage_fns_.size(); ++s) {
     const auto t0 = std::chrono::steady_clock::now();
     stage_fns_[s].run();
@@ -354,17 +389,22 @@ void Simulation<Dim>::grid_velocity(const Vec<Dim>& gravity) {
 }
 
 template <int Dim>
-void Simulation<Dim>::apply_drive_to_grid() {
-  // The piston face sits at x_w = V t and moves at V: nodes at or behind it cannot move slower
-  // than the piston (contact that allows separation, no friction on the face).
-  const double xw = scene_.drive_position(time_);
-  const double v = scene_.drive_velocity(time_);
-  const int last = static_cast<int>(std::floor(xw / grid_.dx)) - grid_.lo[0];
-  if (last < 0) return;
-  const std::size_t end = std::min(grid_.node_count(),
-                                   static_cast<std::size_t>(last + 1) * (grid_.node_count() / grid_.n[0]));
-  for (std::size_t f = 0; f < end; ++f)
-    if (grid_.mass[f] > 0.0) grid_.vel[f][0] = std::max(grid_.vel[f][0], v);
+void Simulation<Dim>::drive_back_layer() {
+  // The piston is the back layer of ice (one cell thick), moved kinematically along x at the
+  // drive speed and free to slide vertically. A grid-node wall instead gives the ice an impulse
+  // each time its face crosses a node column, which builds a grid-scale stress oscillation
+  // behind the face (seen as tensile bands that crack the back of the slab).
+  auto& P = particles_;
+  const double shift = settling_ ? 0.0 : scene_.drive_position(time_);
+  const double v = settling_ ? 0.0 : scene_.drive_velocity(time_);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, P.size(), kGrain), [&](const auto& r) {
+    for (std::size_t p = r.begin(); p != r.end(); ++p) {
+      if (std::isnan(P.drive_x0[p])) continue;
+      P.x[p][0] = P.drive_x0[p] + shift;
+      P.v[p][0] = v;
+      P.C[p].row(0).setZero();
+    }
+  });
 }
 
 template <int Dim>

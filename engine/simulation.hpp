@@ -33,6 +33,9 @@ class Simulation {
   explicit Simulation(const SceneConfig& scene);  // scene must be resolve()d
 
   void step();
+  // Runs the settling phase (scene.settle_time) if it has not run yet; step() calls it first.
+  void settle();
+  bool settled() const { return settled_; }
 
   double time() const { return time_; }
   double last_dt() const { return dt_; }
@@ -73,7 +76,7 @@ class Simulation {
   void prepare_grid();
   void particle_to_grid();
   void grid_velocity(const Vec<Dim>& gravity);
-  void apply_drive_to_grid();
+  void drive_back_layer();
   void apply_bed_friction_to_grid();
   void apply_walls_to_grid(const std::vector<int>& axes, const Vec<Dim>& lo, const Vec<Dim>& hi);
   void apply_velocity_boxes_to_grid();
@@ -112,6 +115,9 @@ class Simulation {
   double removed_mass_ = 0.0;
   double front_x_ = 0.0;
   double max_speed_ = 0.0;
+  bool settled_ = false;
+  bool settling_ = false;
+  double settle_damping_rate_ = 0.0;
 };
 
 extern template class Simulation<2>;

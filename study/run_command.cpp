@@ -6,6 +6,9 @@
 #include <fstream>
 #include <memory>
 
+#include "analysis/crevasse_measure.hpp"
+#include "analysis/measurement_io.hpp"
+#include "analysis/side_view.hpp"
 #include "engine/error.hpp"
 #include "engine/run.hpp"
 #include "engine/vtu_writer.hpp"
@@ -94,6 +97,19 @@ int run_command(const RunCommandOptions& opt) {
       {"engine_version", CREVASSE_ENGINE_VERSION},
   };
   std::ofstream(out / "run_summary.json") << summary.dump(2) << "\n";
+
+  // Crevasses at the end of the run (SPEC §5), and the side view with each one marked.
+  const analysis::CrevasseMeasurement m = analysis::measure_crevasses(r.final_snapshot, analysis::MeasureSettings{});
+  analysis::write_crevasses_csv(m, out / "crevasses.csv");
+  analysis::write_measurement_summary(m, out / "measurement.json");
+  if (scene.png && r.final_snapshot.size() > 0) {
+    analysis::SideViewOptions view;
+    char extra[128];
+    const double pi_group = scene.tensile_strength / (scene.density * scene.gravity * scene.ice_thickness);
+    std::snprintf(extra, sizeof extra, "c = %.3g MPa   Pi = %.3g", scene.tensile_strength / 1e6, pi_group);
+    view.title_extra = extra;
+    analysis::write_side_view_png(r.final_snapshot, (out / "side_view.png").string(), view, &m);
+  }
   if (!opt.quiet) {
     std::fprintf(stderr, "done: %s after %lld steps, t = %.1f s, wall %.1f s (%.2f M particle-steps/s) -> %s\n",
                  r.stop_reason.c_str(), static_cast<long long>(r.steps), r.sim_time_s, r.wall_s,
