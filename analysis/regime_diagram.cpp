@@ -57,24 +57,21 @@ void add_fit_curve(Figure& figure, std::vector<double> x, Value&& value, Band&& 
   figure.add_line(x, y, {kFitLine, 1.6, {}}, curve_legend);
 }
 
-void add_power_law(Figure& figure, const PowerLawFit& fit, const RegimeDiagramOptions& options) {
+// Each add_* draws the fit and returns its annotation lines, top to bottom.
+std::vector<std::string> add_power_law(Figure& figure, const PowerLawFit& fit,
+                                       const RegimeDiagramOptions& options) {
   const PowerLaw& law = fit.law;
   add_fit_curve(
       figure, log_spaced(fit.x_min, fit.x_max, 120), [&](double x) { return law.value(x); },
       [&](double x) { return law.confidence_band(x, fit.level); }, "power-law fit");
-  const TextStyle style{9.5, kFitLine, TextAnchor::right, true};
-  figure.add_text_in_axes(0.97, 0.12,
-                          options.y_label + " = " + significant(fit.a()) + " " + options.x_symbol +
-                              "^{" + fixed(fit.b(), 2) + "}",
-                          style);
-  figure.add_text_in_axes(0.97, 0.05,
-                          exponent_text("b", fit.b(), fit.ci_b, false) + ",  R^2 = " +
-                              fixed(fit.r_squared, 3) + ",  n = " + std::to_string(fit.n),
-                          style);
+  return {options.y_label + " = " + significant(fit.a()) + " " + options.x_symbol + "^{" +
+              fixed(fit.b(), 2) + "}",
+          exponent_text("b", fit.b(), fit.ci_b, false) + ",  R^2 = " + fixed(fit.r_squared, 3) +
+              ",  n = " + std::to_string(fit.n)};
 }
 
-void add_broken_line(Figure& figure, const BrokenLineFit& fit,
-                     const RegimeDiagramOptions& options) {
+std::vector<std::string> add_broken_line(Figure& figure, const BrokenLineFit& fit,
+                                         const RegimeDiagramOptions& options) {
   const double lo = std::min(fit.segment_x_min[0], fit.segment_x_min[1]);
   const double hi = std::max(fit.segment_x_max[0], fit.segment_x_max[1]);
   std::vector<double> x = log_spaced(lo, hi, 160);
@@ -90,27 +87,38 @@ void add_broken_line(Figure& figure, const BrokenLineFit& fit,
       figure, x, [&](double xi) { return fit.value(xi); },
       [&](double xi) { return fit.confidence_band(xi); }, "broken-line fit");
 
-  const TextStyle style{9.5, kFitLine, TextAnchor::right, true};
   const std::string clipped_low = fit.breakpoint_ci_clipped_low ? "≤" : "";
   const std::string clipped_high = fit.breakpoint_ci_clipped_high ? "≥" : "";
-  figure.add_text_in_axes(0.97, 0.19,
-                          options.x_symbol + "^* = " + significant(fit.breakpoint) + " [" +
-                              clipped_low + significant(fit.breakpoint_ci.lower) + ", " +
-                              clipped_high + significant(fit.breakpoint_ci.upper) + "]",
-                          style);
-  figure.add_text_in_axes(0.97, 0.12,
-                          exponent_text("b_1", fit.b[0], fit.ci_b[0], fit.b_fixed[0]) + ",  " +
-                              exponent_text("b_2", fit.b[1], fit.ci_b[1], fit.b_fixed[1]),
-                          style);
   const ModelComparison& c = fit.comparison;
   const std::string test = std::isnan(c.p_value) ? "F test n/a"
                            : c.p_value < 0.001   ? "F test p < 0.001"
                                                  : "F test p = " + significant(c.p_value);
-  figure.add_text_in_axes(
-      0.97, 0.05,
-      std::string(c.two_regimes_warranted ? "two regimes: " : "one regime suffices: ") + test +
-          ",  ΔAIC = " + fixed(c.aic_broken - c.aic_single, 1),
-      style);
+  return {options.x_symbol + "^* = " + significant(fit.breakpoint) + " [" + clipped_low +
+              significant(fit.breakpoint_ci.lower) + ", " + clipped_high +
+              significant(fit.breakpoint_ci.upper) + "]",
+          exponent_text("b_1", fit.b[0], fit.ci_b[0], fit.b_fixed[0]) + ",  " +
+              exponent_text("b_2", fit.b[1], fit.ci_b[1], fit.b_fixed[1]),
+          std::string(c.two_regimes_warranted ? "two regimes: " : "one regime suffices: ") + test +
+              ",  ΔAIC = " + fixed(c.aic_broken - c.aic_single, 1)};
+}
+
+// Annotations go in a corner the legend does not use: bottom right, or top left when the
+// legend sits at the bottom (rising data leave those corners empty most often).
+void add_annotations(Figure& figure, const std::vector<std::string>& lines, LegendPosition legend) {
+  const bool legend_at_bottom =
+      legend == LegendPosition::lower_left || legend == LegendPosition::lower_right;
+  const double step = 0.07;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const double k = static_cast<double>(i);
+    if (legend_at_bottom) {
+      figure.add_text_in_axes(0.03, 0.93 - k * step, lines[i],
+                              {9.5, kFitLine, TextAnchor::left, true});
+    } else {
+      const double from_bottom = static_cast<double>(lines.size() - 1) - k;
+      figure.add_text_in_axes(0.97, 0.05 + from_bottom * step, lines[i],
+                              {9.5, kFitLine, TextAnchor::right, true});
+    }
+  }
 }
 
 }  // namespace
@@ -141,17 +149,22 @@ Figure regime_diagram(const std::vector<RegimePoint>& points, const RegimeFit& f
     }
   }
 
-  if (const auto* power = std::get_if<PowerLawFit>(&fit)) add_power_law(figure, *power, options);
-  if (const auto* broken = std::get_if<BrokenLineFit>(&fit))
-    add_broken_line(figure, *broken, options);
+  std::vector<std::string> annotations;
+  if (const auto* power = std::get_if<PowerLawFit>(&fit)) {
+    annotations = add_power_law(figure, *power, options);
+  }
+  if (const auto* broken = std::get_if<BrokenLineFit>(&fit)) {
+    annotations = add_broken_line(figure, *broken, options);
+  }
 
-  bool failed_in_legend = false;
+  // Failed cases after all groups, so the legend lists the groups first.
+  std::vector<std::vector<double>> failed_x(groups.size());
   for (std::size_t g = 0; g < groups.size(); ++g) {
-    std::vector<double> x, y, x_bar, lo, hi, x_failed;
+    std::vector<double> x, y, x_bar, lo, hi;
     for (const RegimePoint& p : points) {
       if (p.group != groups[g]) continue;
       if (p.failed) {
-        x_failed.push_back(p.pi);
+        failed_x[g].push_back(p.pi);
         continue;
       }
       x.push_back(p.pi);
@@ -166,12 +179,15 @@ Figure regime_diagram(const std::vector<RegimePoint>& points, const RegimeFit& f
     figure.add_error_bars(x_bar, lo, hi, color.with_alpha(0.8));
     figure.add_points(x, y, {palette_marker(g), color, 6.5, true},
                       groups[g].empty() ? "cases" : groups[g]);
-    if (!x_failed.empty()) {
-      figure.add_bottom_markers(x_failed, {MarkerShape::cross, color, 6.0, false},
-                                failed_in_legend ? "" : "failed / no crevasse");
-      failed_in_legend = true;
-    }
   }
+  bool failed_in_legend = false;
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    if (failed_x[g].empty()) continue;
+    figure.add_bottom_markers(failed_x[g], {MarkerShape::cross, palette_color(g), 6.0, false},
+                              failed_in_legend ? "" : "failed / no crevasse");
+    failed_in_legend = true;
+  }
+  add_annotations(figure, annotations, options.legend);
   return figure;
 }
 
