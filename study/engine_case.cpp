@@ -1,0 +1,71 @@
+#include "study/engine_case.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "analysis/measurement_io.hpp"
+#include "engine/error.hpp"
+#include "engine/run.hpp"
+
+namespace crevasse {
+namespace {
+
+class CaseObserver : public RunObserver {
+ public:
+  explicit CaseObserver(CaseContext& ctx) : ctx_(ctx) {}
+  void on_progress(const RunProgress& p) override { ctx_.report_fraction(p.fraction_done); }
+  bool cancelled() override { return ctx_.should_stop(); }
+  double progress_interval_s() const override { return 0.5; }
+
+ private:
+  CaseContext& ctx_;
+};
+
+void check_finite(const ParticleSnapshot& s) {
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const bool ok = std::isfinite(s.x[i]) && std::isfinite(s.z[i]) && std::isfinite(s.eps_v_p[i]) &&
+                    (s.y.empty() || std::isfinite(s.y[i]));
+    if (!ok)
+      throw SimulationError("non-finite state of particle " + std::to_string(i) + " at the end of the run (t = " +
+                            std::to_string(s.time_s) + " s)");
+  }
+}
+
+}  // namespace
+
+CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx) {
+  SceneConfig scene = study_case.scene;
+  scene.vtu_interval = 0.0;
+  scene.png = false;
+  if (ctx.time_limit_s() > 0)
+    scene.wall_time_limit = scene.wall_time_limit > 0 ? std::min(scene.wall_time_limit, ctx.time_limit_s())
+                                                      : ctx.time_limit_s();
+  CaseObserver observer(ctx);
+  RunSummary r = run_scene(scene, &observer);
+
+  CaseOutcome out;
+  if (r.stop_reason == "cancelled") {
+    out.cancelled = true;
+    return out;
+  }
+  check_finite(r.final_snapshot);
+  out.stop_reason = r.stop_reason;
+  out.steps = r.steps;
+  out.particle_steps = r.particle_steps;
+  out.sim_time_s = r.sim_time_s;
+  out.result_extra = {{"initial_mass_kg", r.initial_mass},       {"final_mass_kg", r.final_mass},
+                      {"removed_mass_kg", r.removed_mass},       {"initial_particles", r.initial_particles},
+                      {"final_particles", r.final_particles},    {"return_map_evaluations", r.return_map_evaluations}};
+  out.run_json = {{"engine_wall_s", r.wall_s},
+                  {"stage_seconds", r.stage_seconds},
+                  {"particle_steps_per_s", r.wall_s > 0 ? static_cast<double>(r.particle_steps) / r.wall_s : 0.0}};
+  try {
+    out.measurement = analysis::measure_crevasses(r.final_snapshot, ctx.measurement());
+  } catch (const std::invalid_argument& e) {
+    throw SimulationError(std::string("measurement of the final snapshot failed: ") + e.what());
+  }
+  return out;
+}
+
+}  // namespace crevasse

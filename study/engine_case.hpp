@@ -1,0 +1,13 @@
+#pragma once
+// The real case function of the runner: simulate the case's scene with the engine, then
+// measure its crevasses (SPEC §5) at the end of the run.
+#include "study/runner.hpp"
+
+namespace crevasse {
+
+// Runs the engine (the runner's time limit becomes run.wall_time_limit; cancellation goes
+// through the engine's observer) and measures the final snapshot with ctx.measurement().
+// Throws SimulationError on instability, time limit or non-finite results.
+CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx);
+
+}  // namespace crevasse
