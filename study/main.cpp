@@ -5,7 +5,11 @@
 #include <exception>
 
 #include "engine/error.hpp"
+#include "study/export_command.hpp"
+#include "study/merge.hpp"
 #include "study/run_command.hpp"
+#include "study/status_command.hpp"
+#include "study/study_command.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"crevasse: scaling laws of glacier fracture from MPM parameter studies"};
@@ -19,9 +23,45 @@ int main(int argc, char** argv) {
   run->add_option("--threads", run_opt.threads, "Worker threads (default: all cores)");
   run->add_flag("--quiet", run_opt.quiet, "No progress output");
 
+  crevasse::StudyCommandOptions study_opt;
+  auto* study = app.add_subcommand("study", "Run or resume a parameter study into its SQLite database");
+  study->add_option("file", study_opt.study_path, "Study JSON file (see docs/study_format.md, studies/)")->required();
+  study->add_option("--db", study_opt.db_path, "Database (default results/<name>.db)");
+  study->add_option("--jobs", study_opt.jobs, "Cases at once (default: cores / threads per case)")->check(CLI::Range(1, 1024));
+  study->add_option("--threads-per-case", study_opt.threads_per_case, "Engine threads per case (default 1)")->check(CLI::Range(1, 1024));
+  study->add_option("--case-time-limit", study_opt.case_time_limit_s, "Wall seconds per case, 0 = none (default: the study's resources)")->check(CLI::Range(0.0, 1e8));
+  study->add_option("--shard", study_opt.shard, "Run only shard I of N (I/N, 0 <= I < N)");
+  study->add_flag("--fail-fast", study_opt.fail_fast, "Stop at the first failing case");
+  study->add_flag("--retry-failed", study_opt.retry_failed, "Run cases stored as failed again");
+  study->add_flag("--dry-run", study_opt.dry_run, "List the cases and their hashes; run nothing");
+  study->add_flag("--quiet", study_opt.quiet, "No progress output");
+
+  crevasse::StatusCommandOptions status_opt;
+  auto* status = app.add_subcommand("status", "Summarise a study database (safe while the study runs)");
+  status->add_option("db", status_opt.db_path, "Study database")->required();
+  status->add_flag("--all", status_opt.all_cases, "List every finished case");
+
+  crevasse::ExportCommandOptions export_opt;
+  auto* export_cmd = app.add_subcommand("export", "Write a study database as CSV files, one per table");
+  export_cmd->add_option("db", export_opt.db_path, "Study database")->required();
+  export_cmd->add_option("--csv", export_opt.csv_dir, "Output directory")->required();
+
+  std::string merge_out;
+  std::vector<std::string> merge_in;
+  auto* merge = app.add_subcommand("merge", "Combine the databases of one study's shards");
+  merge->add_option("out", merge_out, "Output database (created or extended)")->required();
+  merge->add_option("inputs", merge_in, "Input databases")->required();
+
   try {
     app.parse(argc, argv);
     if (*run) return crevasse::run_command(run_opt);
+    if (*study) {
+      for (int i = 0; i < argc; ++i) study_opt.command_line += std::string(i ? " " : "") + argv[i];
+      return crevasse::study_command(study_opt);
+    }
+    if (*status) return crevasse::status_command(status_opt);
+    if (*export_cmd) return crevasse::export_command(export_opt);
+    if (*merge) return crevasse::merge_command(merge_out, merge_in);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   } catch (const crevasse::InputError& e) {

@@ -1,0 +1,145 @@
+#include "study/merge.hpp"
+
+#include <cstdio>
+#include <map>
+#include <optional>
+
+#include "engine/error.hpp"
+#include "study/store.hpp"
+
+namespace crevasse {
+namespace fs = std::filesystem;
+
+namespace {
+
+struct CaseState {
+  std::string status;
+  std::string result_hash;
+  std::string label;
+};
+
+std::map<std::string, CaseState> case_states(Store& store, const std::string& schema) {
+  std::map<std::string, CaseState> out;
+  Statement s(store.handle(), "SELECT case_id, status, coalesce(result_hash, ''), label FROM " + schema + ".cases");
+  while (s.step()) out[s.text(0)] = {s.text(1), s.text(2), s.text(3)};
+  return out;
+}
+
+bool finished(const std::string& status) { return status == "done" || status == "failed"; }
+
+void copy_case(Store& store, const std::string& case_id) {
+  for (const char* table : {"crevasses", "summaries", "cases"}) {
+    Statement d(store.handle(), std::string("DELETE FROM main.") + table + " WHERE case_id = ?");
+    d.bind(1, case_id);
+    d.run();
+  }
+  for (const char* table : {"cases", "crevasses", "summaries"}) {
+    Statement i(store.handle(),
+                std::string("INSERT INTO main.") + table + " SELECT * FROM src." + table + " WHERE case_id = ?");
+    i.bind(1, case_id);
+    i.run();
+  }
+  Statement p(store.handle(), "UPDATE main.cases SET status = 'pending' WHERE case_id = ? AND status = 'running'");
+  p.bind(1, case_id);
+  p.run();
+}
+
+}  // namespace
+
+MergeReport merge_databases(const fs::path& out, const std::vector<fs::path>& inputs) {
+  if (inputs.empty()) throw InputError("merge: give at least one input database");
+  std::error_code ec;
+  for (const auto& in : inputs) {
+    if (fs::exists(out) && fs::equivalent(in, out, ec))
+      throw InputError("merge: input " + in.string() + " is the output database; give a new OUT path");
+    Store::open_reader(in);  // exists and is a study database of this schema
+  }
+  MergeReport report;
+  Store store = Store::open_writer(out);
+  for (const auto& in : inputs) {
+    {
+      Statement a(store.handle(), "ATTACH DATABASE ? AS src");
+      a.bind(1, in.string());
+      a.run();
+    }
+    try {
+      std::optional<std::string> src_hash, src_name;
+      {
+        Statement s(store.handle(), "SELECT study_hash, name FROM src.study WHERE id = 1");
+        if (s.step()) {
+          src_hash = s.text(0);
+          src_name = s.text(1);
+        }
+      }
+      if (!src_hash) throw InputError(in.string() + ": holds no study (was it ever run?)");
+      store.transaction([&] {
+        if (const auto mine = store.study_hash()) {
+          if (*mine != *src_hash) {
+            Statement s(store.handle(), "SELECT name FROM main.study WHERE id = 1");
+            s.step();
+            throw InputError(in.string() + ": holds study '" + *src_name + "', not the study '" + s.text(0) +
+                             "' already in " + out.string() + " (other cases or engine version); merge only "
+                             "databases of one study");
+          }
+          store.exec(
+              "UPDATE main.study SET ended_at = (SELECT nullif(max(coalesce(a.ended_at, ''), coalesce(b.ended_at, '')), '') "
+              "FROM main.study a, src.study b) WHERE id = 1");
+        } else {
+          store.exec("INSERT INTO main.study SELECT * FROM src.study");
+        }
+        store.exec("INSERT OR IGNORE INTO main.sessions SELECT * FROM src.sessions");
+        const auto mine = case_states(store, "main");
+        const auto theirs = case_states(store, "src");
+        for (const auto& [id, src] : theirs) {
+          const auto it = mine.find(id);
+          if (it == mine.end() || (!finished(it->second.status) && finished(src.status))) {
+            copy_case(store, id);
+            ++report.copied;
+            continue;
+          }
+          const CaseState& dst = it->second;
+          if (!finished(src.status)) continue;  // nothing to add
+          if (dst.status == src.status && dst.result_hash == src.result_hash) {
+            ++report.identical;
+            continue;
+          }
+          ++report.conflicts;
+          std::string line = "case " + id.substr(0, 12) + " (" + src.label + "): " + out.filename().string() +
+                             " has " + dst.status + " (result " + dst.result_hash.substr(0, 12) + "), " +
+                             in.filename().string() + " has " + src.status + " (result " +
+                             src.result_hash.substr(0, 12) + ")";
+          if (dst.status == "failed" && src.status == "done") {
+            copy_case(store, id);
+            line += "; kept the finished result from " + in.filename().string();
+          } else {
+            line += "; kept " + out.filename().string() + "'s";
+          }
+          report.conflict_lines.push_back(line);
+        }
+      });
+    } catch (...) {
+      sqlite3_exec(store.handle(), "DETACH DATABASE src", nullptr, nullptr, nullptr);
+      throw;
+    }
+    store.exec("DETACH DATABASE src");
+    ++report.inputs;
+  }
+  store.checkpoint();
+  return report;
+}
+
+int merge_command(const std::string& out, const std::vector<std::string>& inputs) {
+  std::vector<fs::path> in(inputs.begin(), inputs.end());
+  const MergeReport r = merge_databases(out, in);
+  for (const auto& line : r.conflict_lines) std::fprintf(stderr, "conflict: %s\n", line.c_str());
+  Store store = Store::open_reader(out);
+  const StatusCounts c = store.counts();
+  std::printf("merged %zu database(s) into %s: %zu case(s) copied, %zu identical, %zu conflict(s); now %lld done, "
+              "%lld failed, %lld pending of %lld\n",
+              r.inputs, out.c_str(), r.copied, r.identical, r.conflicts, static_cast<long long>(c.done),
+              static_cast<long long>(c.failed), static_cast<long long>(c.pending + c.running),
+              static_cast<long long>(c.total()));
+  return r.conflicts > 0 ? 1 : 0;
+}
+
+}  // namespace crevasse

@@ -1,0 +1,26 @@
+#pragma once
+// `crevasse merge OUT.db IN1.db IN2.db ...`: combines the databases of one study's shards (or
+// of repeated runs) into one. A case stored in several inputs is kept once; a finished case
+// beats a pending one; two finished copies with different results (result_hash) are a
+// conflict: the first is kept and the conflict reported.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace crevasse {
+
+struct MergeReport {
+  std::size_t inputs = 0;
+  std::size_t copied = 0;     // cases added or upgraded (pending → finished)
+  std::size_t identical = 0;  // already present with the same result
+  std::size_t conflicts = 0;
+  std::vector<std::string> conflict_lines;  // one line per conflict
+};
+
+// Throws InputError when an input is missing, is OUT itself, or holds another study.
+MergeReport merge_databases(const std::filesystem::path& out, const std::vector<std::filesystem::path>& inputs);
+
+// The CLI command: prints the report; returns 0, or 1 when there were conflicts.
+int merge_command(const std::string& out, const std::vector<std::string>& inputs);
+
+}  // namespace crevasse

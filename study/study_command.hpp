@@ -1,0 +1,26 @@
+#pragma once
+// `crevasse study FILE [--db PATH] [--jobs N] ...`: runs (or resumes) a study into its SQLite
+// database, with progress on stderr.
+#include <string>
+
+namespace crevasse {
+
+struct StudyCommandOptions {
+  std::string study_path;
+  std::string db_path;       // "" → results/<name>.db (results/<name>.shard-I-of-N.db with --shard)
+  int jobs = 0;              // 0 → resources.jobs, else cores / threads per case
+  int threads_per_case = 0;  // 0 → resources.threads_per_case, else 1
+  double case_time_limit_s = -1.0;  // < 0 → resources.case_time_limit_s
+  std::string shard;         // "I/N" or ""
+  bool fail_fast = false;
+  bool retry_failed = false;
+  bool dry_run = false;      // list the cases and their hashes; run nothing, create nothing
+  bool quiet = false;
+  std::string command_line;  // recorded in the sessions table
+};
+
+// 0 when every case in scope is done; 1 when some failed or --fail-fast stopped the run.
+// Throws InputError (exit 2) for a bad study file, database or option.
+int study_command(const StudyCommandOptions& opt);
+
+}  // namespace crevasse
