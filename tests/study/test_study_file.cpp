@@ -1,0 +1,259 @@
+// Study files: enumeration, axis ranges, derived dimensional parameters, and one specific
+// refusal per kind of mistake.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+#include "engine/error.hpp"
+#include "study/shard.hpp"
+#include "study/study_file.hpp"
+#include "study_test_support.hpp"
+
+namespace crevasse {
+namespace {
+
+using nlohmann::json;
+using test::parse;
+using test::tiny_scene;
+
+json base_study() {
+  return {{"name", "t"}, {"base_scene", tiny_scene()}};
+}
+
+TEST(StudyFile, LinearAndLogAxesIncludeBothEndsAndRoundCleanly) {
+  const auto lin = expand_axis(json{{"linear", {0.0, 1.0, 5}}}, "x");
+  ASSERT_EQ(lin.size(), 5u);
+  EXPECT_EQ(lin[1].get<double>(), 0.25);
+  EXPECT_EQ(lin[4].get<double>(), 1.0);
+  const auto log = expand_axis(json{{"log", {0.01, 1.0, 3}}}, "x");
+  ASSERT_EQ(log.size(), 3u);
+  EXPECT_EQ(log[0].get<double>(), 0.01);
+  EXPECT_EQ(log[1].get<double>(), 0.1);  // not 0.09999999999999999
+  EXPECT_EQ(log[2].get<double>(), 1.0);
+  const auto list = expand_axis(json::array({3, "a", 2.5}), "x");
+  ASSERT_EQ(list.size(), 3u);
+  EXPECT_EQ(list[1], "a");
+  EXPECT_EQ(expand_axis(json{{"linear", {2.0, 2.0, 1}}}, "x").size(), 1u);
+}
+
+TEST(StudyFile, CartesianProductLastAxisFastestReplicasInnermost) {
+  json j = base_study();
+  j["base_scene"]["numerics"]["jitter"] = 0.2;
+  j["sweep"] = json::object();
+  j["sweep"]["thickness"] = {40, 60};
+  j["sweep"]["cohesion_ratio"] = {{"log", {0.1, 1.0, 3}}};
+  j["replicas"] = {{"count", 2}, {"first_seed", 7}};
+  // nlohmann::json sorts keys; the study keeps the file's order, so build the text by hand.
+  const std::string text = R"({"name": "t", "base_scene": )" + j["base_scene"].dump() +
+                           R"(, "sweep": {"thickness": [40, 60], "cohesion_ratio": {"log": [0.1, 1, 3]}},
+                              "replicas": {"count": 2, "first_seed": 7}})";
+  const Study s = parse_study(text, ".", "test");
+  ASSERT_EQ(s.cases.size(), 12u);
+  EXPECT_EQ(s.cases[0].label, "thickness=40 cohesion_ratio=0.1 replica=0");
+  EXPECT_EQ(s.cases[1].label, "thickness=40 cohesion_ratio=0.1 replica=1");
+  EXPECT_EQ(s.cases[2].label, "thickness=40 cohesion_ratio=0.316228 replica=0");
+  EXPECT_EQ(s.cases[6].label, "thickness=60 cohesion_ratio=0.1 replica=0");
+  EXPECT_EQ(s.cases[0].scene.seed, 7u);
+  EXPECT_EQ(s.cases[1].scene.seed, 8u);
+  EXPECT_EQ(s.cases[11].axes["replica"], 1);
+  EXPECT_EQ(s.cases[11].axes["thickness"], 60);
+  std::set<std::string> ids;
+  for (const auto& c : s.cases) {
+    EXPECT_EQ(c.case_id.size(), 64u);
+    ids.insert(c.case_id);
+  }
+  EXPECT_EQ(ids.size(), 12u);
+  for (std::size_t i = 0; i < s.cases.size(); ++i) EXPECT_EQ(s.cases[i].index, i);
+}
+
+TEST(StudyFile, DerivesTensileStrengthStepAndWidthFromTheGroups) {
+  json j = base_study();
+  j["fixed"] = {{"/ice/density", 900.0}, {"/gravity/g", 9.8}, {"thickness", 60.0},
+                {"step_length_ratio", 2.0}, {"slope", 0.5}, {"front_past_step_ratio", 3.0},
+                {"upstream_length_ratio", 6.0}, {"downstream_length_ratio", 8.0}, {"cells_per_thickness", 12.0}};
+  j["sweep"] = {{"cohesion_ratio", {0.05, 0.5}}};
+  const Study s = parse(j);
+  ASSERT_EQ(s.cases.size(), 2u);
+  const SceneConfig& sc = s.cases[1].scene;
+  EXPECT_DOUBLE_EQ(sc.ice_thickness, 60.0);
+  EXPECT_DOUBLE_EQ(sc.tensile_strength, 0.5 * 900.0 * 9.8 * 60.0);  // c = Π ρ g H_i
+  EXPECT_DOUBLE_EQ(sc.step_length, 120.0);                          // L_s = r H_i
+  EXPECT_DOUBLE_EQ(sc.step_height, 60.0);                           // H_s = S L_s
+  EXPECT_DOUBLE_EQ(sc.front_past_step, 180.0);
+  EXPECT_DOUBLE_EQ(sc.upstream_length, 360.0);
+  EXPECT_DOUBLE_EQ(sc.downstream_length, 480.0);
+  EXPECT_DOUBLE_EQ(sc.dx, 5.0);
+  // The groups read back from the resolved scene are the ones asked for.
+  EXPECT_NEAR(s.cases[0].groups.cohesion_ratio, 0.05, 1e-12);
+  EXPECT_NEAR(s.cases[1].groups.cohesion_ratio, 0.5, 1e-12);
+  EXPECT_DOUBLE_EQ(s.cases[1].groups.step_length_ratio, 2.0);
+  ASSERT_TRUE(s.cases[1].groups.slope.has_value());
+  EXPECT_DOUBLE_EQ(*s.cases[1].groups.slope, 0.5);
+  EXPECT_FALSE(s.cases[1].groups.width_ratio.has_value());
+  // The canonical scene has every default spelled out.
+  EXPECT_TRUE(s.cases[0].scene_json.contains("ice"));
+  EXPECT_EQ(s.cases[0].scene_json["ice"]["poisson_ratio"], 0.3);
+}
+
+TEST(StudyFile, VerticalStepTakesItsHeightFromStepHeightRatio) {
+  json j = base_study();
+  j["fixed"] = {{"step_length_ratio", 0.0}, {"step_height_ratio", 1.5}};
+  const Study s = parse(j);
+  ASSERT_EQ(s.cases.size(), 1u);
+  EXPECT_EQ(s.cases[0].scene.step_length, 0.0);
+  EXPECT_DOUBLE_EQ(s.cases[0].scene.step_height, 60.0);
+  EXPECT_FALSE(s.cases[0].groups.slope.has_value());
+  EXPECT_DOUBLE_EQ(s.cases[0].groups.step_height_ratio, 1.5);
+}
+
+TEST(StudyFile, ThreeDWidthFromWidthRatio) {
+  json j = base_study();
+  j["fixed"] = {{"/dim", 3}, {"width_ratio", 0.5}, {"thickness", 40.0}};
+  j["base_scene"]["effects"].push_back("lateral_walls");
+  const Study s = parse(j);
+  EXPECT_EQ(s.cases[0].scene.dim, 3);
+  EXPECT_DOUBLE_EQ(s.cases[0].scene.width, 20.0);
+  ASSERT_TRUE(s.cases[0].groups.width_ratio.has_value());
+  EXPECT_DOUBLE_EQ(*s.cases[0].groups.width_ratio, 0.5);
+}
+
+TEST(StudyFile, AnySceneParameterByJsonPointer) {
+  json j = base_study();
+  j["sweep"] = {{"/bed/friction", {0.0, 0.1, 0.3}}, {"/bed/shape", {"step", "concave"}}};
+  const Study s = parse(j);
+  ASSERT_EQ(s.cases.size(), 6u);
+  std::set<std::pair<double, std::string>> seen;
+  for (const auto& c : s.cases) seen.emplace(c.scene.bed_friction, c.scene.bed_shape);
+  EXPECT_EQ(seen.size(), 6u);
+}
+
+TEST(StudyFile, BaseSceneFromAFileRelativeToTheStudy) {
+  test::ScratchDir dir("studyfile");
+  std::filesystem::create_directories(dir / "scenes");
+  test::write_text(dir / "scenes" / "s.json", tiny_scene().dump());
+  test::write_text(dir / "study.json", R"({"name": "f", "base_scene": "scenes/s.json",
+                                          "sweep": {"cohesion_ratio": [0.1, 0.2]}})");
+  const Study s = load_study_file(dir / "study.json");
+  EXPECT_EQ(s.cases.size(), 2u);
+  EXPECT_NE(s.source_text.find("scenes/s.json"), std::string::npos);
+  EXPECT_EQ(s.base_scene["ice"]["thickness"], 40.0);
+}
+
+TEST(StudyFile, ResourcesAndMeasurementSettings) {
+  json j = base_study();
+  j["resources"] = {{"jobs", 3}, {"threads_per_case", 2}, {"case_time_limit_s", 60}};
+  j["measurement"] = {{"damage_threshold", 0.9}, {"window_min_x_m", 100.0}, {"surface_smoothing_bins", 5}};
+  const Study s = parse(j);
+  EXPECT_EQ(s.resources.jobs, 3);
+  EXPECT_EQ(s.resources.threads_per_case, 2);
+  EXPECT_EQ(s.resources.case_time_limit_s, 60.0);
+  EXPECT_EQ(s.measurement.damage_threshold, 0.9);
+  ASSERT_TRUE(s.measurement.window_min_x_m.has_value());
+  EXPECT_EQ(*s.measurement.window_min_x_m, 100.0);
+  EXPECT_EQ(s.measurement_json["surface_smoothing_bins"], 5);
+}
+
+// Each mistake gets its own message naming the field (and the value and range where there is one).
+struct BadStudy {
+  const char* what;
+  std::function<void(json&)> edit;
+  std::vector<std::string> expect;  // substrings of the message
+};
+
+class InvalidStudy : public ::testing::TestWithParam<BadStudy> {};
+
+TEST_P(InvalidStudy, IsRefusedWithItsOwnMessage) {
+  json j = base_study();
+  GetParam().edit(j);
+  try {
+    parse(j);
+    FAIL() << GetParam().what << ": accepted";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    for (const auto& s : GetParam().expect) EXPECT_NE(msg.find(s), std::string::npos) << msg << "\nmissing: " << s;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << "one line: " << msg;
+  }
+}
+
+const BadStudy kBadStudies[] = {
+    {"log range with a non-positive bound", [](json& j) { j["sweep"] = {{"cohesion_ratio", {{"log", {-0.1, 1.0, 4}}}}}; },
+     {"sweep.cohesion_ratio.log", "-0.1", "(0, inf)"}},
+    {"log range with zero", [](json& j) { j["sweep"] = {{"cohesion_ratio", {{"log", {0.0, 1.0, 4}}}}}; },
+     {"sweep.cohesion_ratio.log", "bound 0"}},
+    {"count not an integer", [](json& j) { j["sweep"] = {{"cohesion_ratio", {{"linear", {0.1, 1.0, 2.5}}}}}; },
+     {"sweep.cohesion_ratio.linear", "count must be an integer"}},
+    {"count zero", [](json& j) { j["sweep"] = {{"cohesion_ratio", {{"linear", {0.1, 1.0, 0}}}}}; },
+     {"sweep.cohesion_ratio.linear", "count 0", "[1, 10000]"}},
+    {"range of two numbers", [](json& j) { j["sweep"] = {{"cohesion_ratio", {{"linear", {0.1, 1.0}}}}}; },
+     {"sweep.cohesion_ratio.linear", "[first, last, count]"}},
+    {"unknown range kind", [](json& j) { j["sweep"] = {{"cohesion_ratio", {{"geometric", {0.1, 1.0, 3}}}}}; },
+     {"sweep.cohesion_ratio", "must be a list of values"}},
+    {"empty list", [](json& j) { j["sweep"] = {{"cohesion_ratio", json::array()}}; },
+     {"sweep.cohesion_ratio", "empty list"}},
+    {"cohesion ratio out of range", [](json& j) { j["fixed"] = {{"cohesion_ratio", -1.0}}; },
+     {"fixed.cohesion_ratio", "value -1", "(0, 10000]"}},
+    {"group value not a number", [](json& j) { j["sweep"] = {{"slope", {"steep"}}}; },
+     {"sweep.slope", "must be a number"}},
+    {"unknown parameter", [](json& j) { j["sweep"] = {{"cohesion", {0.1}}}; },
+     {"sweep.cohesion", "unknown parameter 'cohesion'", "cohesion_ratio"}},
+    {"pointer to no scene field", [](json& j) { j["fixed"] = {{"/ice/thicknes", 50.0}}; },
+     {"fixed./ice/thicknes", "not a scene parameter", "'thicknes'"}},
+    {"group and its scene field", [](json& j) { j["fixed"] = {{"cohesion_ratio", 0.1}, {"/ice/tensile_strength", 1e5}}; },
+     {"cohesion_ratio", "/ice/tensile_strength", "give only one"}},
+    {"slope and step height ratio", [](json& j) { j["fixed"] = {{"slope", 1.0}, {"step_height_ratio", 1.0}}; },
+     {"slope", "step_height_ratio", "give only one"}},
+    {"slope of a vertical step", [](json& j) { j["fixed"] = {{"step_length_ratio", 0.0}, {"slope", 1.0}}; },
+     {"case 0", "vertical", "step_height_ratio"}},
+    {"width ratio in 2D", [](json& j) { j["fixed"] = {{"width_ratio", 1.0}}; }, {"width_ratio", "3D", "dim 2"}},
+    {"same parameter fixed and swept", [](json& j) { j["fixed"] = {{"thickness", 40.0}}; j["sweep"] = {{"thickness", {40.0, 60.0}}}; },
+     {"sweep.thickness", "also set in fixed"}},
+    {"repeated value", [](json& j) { j["sweep"] = {{"cohesion_ratio", {0.1, 0.2, 0.1}}}; },
+     {"cases 0", "and 2", "same parameters"}},
+    {"replicas without jitter", [](json& j) { j["replicas"] = 3; }, {"replicas", "/numerics/jitter"}},
+    {"replicas out of range", [](json& j) { j["replicas"] = 0; }, {"replicas", "value 0", "[1, 1000]"}},
+    {"missing name", [](json& j) { j.erase("name"); }, {"name", "required"}},
+    {"name with a slash", [](json& j) { j["name"] = "a/b"; }, {"name", "'a/b'"}},
+    {"missing base scene", [](json& j) { j.erase("base_scene"); }, {"base_scene", "required"}},
+    {"base scene file missing", [](json& j) { j["base_scene"] = "no/such/scene.json"; }, {"base_scene", "cannot open"}},
+    {"unknown top-level key", [](json& j) { j["sweeps"] = json::object(); }, {"sweeps", "unknown key"}},
+    {"scene invalid for a case", [](json& j) { j["sweep"] = {{"thickness", {40.0, 20.0}}}; },
+     {"case 1 (thickness=20)", "numerics.dx", "too coarse"}},
+    {"unknown scene key", [](json& j) { j["base_scene"]["ice"]["colour"] = "blue"; }, {"case 0", "ice.colour", "unknown key"}},
+    {"jobs negative", [](json& j) { j["resources"] = {{"jobs", -1}}; }, {"resources.jobs", "value -1", "[0, 1024]"}},
+    {"unknown resource", [](json& j) { j["resources"] = {{"cores", 2}}; }, {"resources.cores", "unknown key"}},
+    {"unknown measurement setting", [](json& j) { j["measurement"] = {{"threshold", 0.9}}; },
+     {"measurement.threshold", "unknown key"}},
+    {"damage threshold out of range", [](json& j) { j["measurement"] = {{"damage_threshold", 1.5}}; },
+     {"measurement.damage_threshold", "1.5", "(0, 1)"}},
+    {"cells per thickness too few", [](json& j) { j["fixed"] = {{"cells_per_thickness", 2.0}}; },
+     {"fixed.cells_per_thickness", "value 2", "[4, 10000]"}},
+};
+
+INSTANTIATE_TEST_SUITE_P(Refusals, InvalidStudy, ::testing::ValuesIn(kBadStudies),
+                         [](const auto& info) { return "case_" + std::to_string(info.index); });
+
+TEST(StudyFile, NotJsonIsRefused) {
+  try {
+    parse_study("{\"name\": \"x\", ", ".", "broken.json");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("broken.json: not valid JSON"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Shard, ParsesAndRefuses) {
+  EXPECT_EQ(parse_shard("0/4").index, 0);
+  EXPECT_EQ(parse_shard("3/4").count, 4);
+  for (const char* bad : {"4/4", "-1/4", "1/0", "a/b", "1", "1/2/3", ""}) {
+    try {
+      parse_shard(bad);
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("--shard"), std::string::npos);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace crevasse
