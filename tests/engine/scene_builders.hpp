@@ -1,0 +1,77 @@
+#pragma once
+// Small scenes for the engine tests, built in code. Every builder returns a resolve()d
+// SceneConfig; callers change fields and call resolve() again only through finish().
+#include <array>
+#include <initializer_list>
+#include <string>
+#include <vector>
+
+#include "engine/scene.hpp"
+#include "engine/simulation.hpp"
+
+namespace crevasse::test {
+
+// Ice properties shared by the tests (SPEC §2 defaults for E, ν, ρ).
+constexpr double kRho = 917.0;
+constexpr double kYoung = 1.0e9;
+constexpr double kPoisson = 0.3;
+constexpr double kG = 9.81;
+
+// A box of ice [lo, hi] inside the domain [domain_lo, domain_hi] (only the first dim entries
+// are used), starting unstressed, with the given effects. Run control: a large max_steps, as
+// the tests drive step() themselves.
+inline SceneConfig box_scene(int dim, std::array<double, 3> lo, std::array<double, 3> hi,
+                             std::array<double, 3> domain_lo, std::array<double, 3> domain_hi,
+                             std::initializer_list<Effect> effects, double dx) {
+  SceneConfig s;
+  s.name = "test_box";
+  s.dim = dim;
+  s.effects = effects;
+  s.body = "box";
+  s.box_min = lo;
+  s.box_max = hi;
+  s.domain_min = domain_lo;
+  s.domain_max = domain_hi;
+  s.bed_shape = "none";
+  s.initial_stress = "none";
+  s.density = kRho;
+  s.youngs_modulus = kYoung;
+  s.poisson_ratio = kPoisson;
+  s.gravity = kG;
+  s.dx = dx;
+  s.max_steps = 1000000000;
+  return s;
+}
+
+inline SceneConfig finish(SceneConfig s) {
+  s.resolve();
+  return s;
+}
+
+// Lamé parameters and wave speeds of the test ice.
+inline double lame_mu() { return kYoung / (2.0 * (1.0 + kPoisson)); }
+inline double lame_lambda() { return kYoung * kPoisson / ((1.0 + kPoisson) * (1.0 - 2.0 * kPoisson)); }
+// P-wave (constrained, uniaxial-strain) modulus λ + 2μ and speed.
+inline double p_wave_modulus() { return lame_lambda() + 2.0 * lame_mu(); }
+
+inline bool has_stage(const std::vector<StageStats>& stages, const std::string& name) {
+  for (const auto& s : stages)
+    if (s.name == name) return true;
+  return false;
+}
+
+// Least-squares line y = a + b x; returns {a, b}.
+inline std::array<double, 2> fit_line(const std::vector<double>& x, const std::vector<double>& y) {
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  const double n = static_cast<double>(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    sx += x[i];
+    sy += y[i];
+    sxx += x[i] * x[i];
+    sxy += x[i] * y[i];
+  }
+  const double b = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  return {(sy - b * sx) / n, b};
+}
+
+}  // namespace crevasse::test
