@@ -1,0 +1,234 @@
+// The runner: cases run concurrently, a failing case does not stop the others, --fail-fast
+// does, time limits fail a case, finished cases are never rerun, and real tiny simulations end
+// up in the database with their crevasse measurements.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <mutex>
+#include <set>
+#include <thread>
+
+#include "engine/error.hpp"
+#include "study/runner.hpp"
+#include "study_test_support.hpp"
+
+namespace crevasse {
+namespace {
+
+using namespace std::chrono_literals;
+
+RunnerOptions fake_options(const std::filesystem::path& db, CaseFunction f, int jobs = 2) {
+  RunnerOptions o;
+  o.db_path = db;
+  o.jobs = jobs;
+  o.threads_per_case = 1;
+  o.case_function = std::move(f);
+  return o;
+}
+
+TEST(Runner, AFailingMiddleCaseIsRecordedAndTheOthersComplete) {
+  test::ScratchDir dir("runner");
+  const Study study = test::parse(test::tiny_study(5));
+  auto fn = [](const StudyCase& c, CaseContext&) {
+    if (c.index == 2) throw SimulationError("instability at step 17, particle 4: |v| = inf");
+    return test::fake_outcome(c);
+  };
+  const RunnerReport r = run_study(study, fake_options(dir / "s.db", fn));
+  EXPECT_EQ(r.done, 4u);
+  EXPECT_EQ(r.failed, 1u);
+  EXPECT_FALSE(r.stopped);
+  EXPECT_NE(r.first_failure.find("instability at step 17"), std::string::npos);
+  const auto rows = test::dump_rows(dir / "s.db", "SELECT case_index, status, coalesce(failure_reason, '') FROM cases "
+                                                  "ORDER BY case_index");
+  ASSERT_EQ(rows.size(), 5u);
+  EXPECT_EQ(rows[2], "2|failed|instability at step 17, particle 4: |v| = inf");
+  for (int i : {0, 1, 3, 4}) EXPECT_EQ(rows[i], std::to_string(i).append("|done|"));
+  // Failed cases have no crevasse rows; the others have index+1 each.
+  EXPECT_EQ(test::dump_rows(dir / "s.db", "SELECT count(*) FROM crevasses").at(0), std::to_string(1 + 2 + 4 + 5));
+  EXPECT_EQ(test::pragma_integrity(dir / "s.db"), "ok");
+}
+
+TEST(Runner, OtherExceptionsFailTheCaseWithTheirReason) {
+  test::ScratchDir dir("runner");
+  const Study study = test::parse(test::tiny_study(3));
+  auto fn = [](const StudyCase& c, CaseContext&) -> CaseOutcome {
+    if (c.index == 0) throw std::runtime_error("measurement went wrong");
+    if (c.index == 1) throw std::bad_alloc();
+    return test::fake_outcome(c);
+  };
+  run_study(study, fake_options(dir / "s.db", fn));
+  const auto rows = test::dump_rows(dir / "s.db", "SELECT failure_reason FROM cases ORDER BY case_index");
+  EXPECT_EQ(rows[0], "error: measurement went wrong");
+  EXPECT_EQ(rows[1], "out of memory");
+  EXPECT_EQ(rows[2], "NULL");
+}
+
+TEST(Runner, FailFastStopsAtTheFirstFailureAndLeavesTheRestPending) {
+  test::ScratchDir dir("runner");
+  const Study study = test::parse(test::tiny_study(5));
+  auto fn = [](const StudyCase& c, CaseContext&) {
+    if (c.index == 1) throw SimulationError("NaN in particle 3");
+    return test::fake_outcome(c);
+  };
+  RunnerOptions o = fake_options(dir / "s.db", fn, 1);
+  o.fail_fast = true;
+  const RunnerReport r = run_study(study, o);
+  EXPECT_TRUE(r.stopped);
+  EXPECT_EQ(r.done, 1u);
+  EXPECT_EQ(r.failed, 1u);
+  EXPECT_EQ(test::dump_rows(dir / "s.db", "SELECT group_concat(status, ',') FROM (SELECT status FROM cases ORDER BY "
+                                          "case_index)")
+                .at(0),
+            "done,failed,pending,pending,pending");
+}
+
+TEST(Runner, FailFastCancelsRunningCasesWhichStayPending) {
+  test::ScratchDir dir("runner");
+  const Study study = test::parse(test::tiny_study(4));
+  auto fn = [](const StudyCase& c, CaseContext& ctx) {
+    if (c.index == 0) {
+      std::this_thread::sleep_for(50ms);
+      throw SimulationError("boom");
+    }
+    while (!ctx.should_stop()) std::this_thread::sleep_for(5ms);  // a long case
+    CaseOutcome o;
+    o.cancelled = true;
+    return o;
+  };
+  RunnerOptions o = fake_options(dir / "s.db", fn, 2);
+  o.fail_fast = true;
+  const RunnerReport r = run_study(study, o);
+  EXPECT_TRUE(r.stopped);
+  EXPECT_EQ(r.cancelled, 1u);
+  const auto c = Store::open_reader(dir / "s.db").counts();
+  EXPECT_EQ(c.failed, 1);
+  EXPECT_EQ(c.pending, 3);
+  EXPECT_EQ(c.running, 0);
+}
+
+TEST(Runner, ACaseOverItsTimeLimitFails) {
+  test::ScratchDir dir("runner");
+  const Study study = test::parse(test::tiny_study(3));
+  auto fn = [](const StudyCase& c, CaseContext& ctx) {
+    if (c.index != 1) return test::fake_outcome(c);
+    while (!ctx.should_stop()) std::this_thread::sleep_for(5ms);
+    CaseOutcome o;
+    o.cancelled = true;
+    return o;
+  };
+  RunnerOptions o = fake_options(dir / "s.db", fn);
+  o.case_time_limit_s = 0.2;
+  const RunnerReport r = run_study(study, o);
+  EXPECT_EQ(r.failed, 1u);
+  EXPECT_EQ(r.done, 2u);
+  const auto reason = test::dump_rows(dir / "s.db", "SELECT failure_reason FROM cases WHERE case_index = 1").at(0);
+  EXPECT_NE(reason.find("time limit"), std::string::npos) << reason;
+}
+
+TEST(Runner, CasesRunConcurrentlyUpToJobs) {
+  test::ScratchDir dir("runner");
+  const Study study = test::parse(test::tiny_study(6));
+  std::atomic<int> now{0}, peak{0};
+  auto fn = [&](const StudyCase& c, CaseContext&) {
+    const int n = ++now;
+    for (int p = peak.load(); n > p && !peak.compare_exchange_weak(p, n);) {
+    }
+    std::this_thread::sleep_for(150ms);
+    --now;
+    return test::fake_outcome(c);
+  };
+  const auto t0 = std::chrono::steady_clock::now();
+  const RunnerReport r = run_study(study, fake_options(dir / "s.db", fn, 3));
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_EQ(r.done, 6u);
+  EXPECT_EQ(r.jobs, 3);
+  EXPECT_LE(peak.load(), 3);
+  EXPECT_GE(peak.load(), 2);
+  EXPECT_LT(wall, 6 * 0.15 * 0.8) << "no concurrency";
+}
+
+TEST(Runner, FinishedCasesAreNeverRunAgain) {
+  test::ScratchDir dir("runner");
+  const Study study = test::parse(test::tiny_study(4));
+  std::mutex m;
+  std::multiset<std::size_t> calls;
+  auto fn = [&](const StudyCase& c, CaseContext&) {
+    {
+      std::lock_guard lock(m);
+      calls.insert(c.index);
+    }
+    if (c.index == 3) throw SimulationError("unstable");
+    return test::fake_outcome(c);
+  };
+  run_study(study, fake_options(dir / "s.db", fn));
+  EXPECT_EQ(calls.size(), 4u);
+  const auto before = test::dump_rows(dir / "s.db", "SELECT case_id, finished_at, session_id FROM cases ORDER BY case_id");
+
+  const RunnerReport again = run_study(study, fake_options(dir / "s.db", fn));
+  EXPECT_EQ(calls.size(), 4u) << "a stored case ran again";
+  EXPECT_EQ(again.already_done, 3u);
+  EXPECT_EQ(again.already_failed, 1u);
+  EXPECT_EQ(again.ran, 0u);
+  EXPECT_EQ(before, test::dump_rows(dir / "s.db", "SELECT case_id, finished_at, session_id FROM cases ORDER BY case_id"));
+
+  RunnerOptions retry = fake_options(dir / "s.db", fn);
+  retry.retry_failed = true;
+  const RunnerReport r3 = run_study(study, retry);
+  EXPECT_EQ(r3.ran, 1u);
+  EXPECT_EQ(calls.count(3), 2u);
+  EXPECT_EQ(test::dump_rows(dir / "s.db", "SELECT count(*) FROM sessions").at(0), "3");
+}
+
+class CountingObserver : public StudyObserver {
+ public:
+  void on_start(const RunnerReport&, const RunnerProgress& p) override { start_pending = p.pending; }
+  void on_case_finished(const StudyCase&, const CaseResult&, const RunnerProgress& p) override {
+    ++finished;
+    last = p;
+  }
+  void on_end(const RunnerReport&) override { ended = true; }
+  std::size_t start_pending = 0, finished = 0;
+  RunnerProgress last;
+  bool ended = false;
+};
+
+TEST(Runner, ReportsProgressToItsObserver) {
+  test::ScratchDir dir("runner");
+  const Study study = test::parse(test::tiny_study(4));
+  CountingObserver obs;
+  RunnerOptions o = fake_options(dir / "s.db", [](const StudyCase& c, CaseContext&) { return test::fake_outcome(c); });
+  o.observer = &obs;
+  run_study(study, o);
+  EXPECT_EQ(obs.start_pending, 4u);
+  EXPECT_EQ(obs.finished, 4u);
+  EXPECT_EQ(obs.last.done, 4u);
+  EXPECT_EQ(obs.last.pending, 0u);
+  EXPECT_EQ(obs.last.total, 4u);
+  EXPECT_TRUE(obs.ended);
+}
+
+// Real simulations: a few hundred steps of the tiny glacier per case, one engine thread each.
+TEST(Runner, RealTinySimulationsAreStoredWithTheirMeasurements) {
+  test::ScratchDir dir("runner");
+  const Study study = test::parse(test::tiny_study(3, 300));
+  RunnerOptions o;
+  o.db_path = dir / "s.db";
+  o.jobs = 2;
+  o.threads_per_case = 1;
+  const RunnerReport r = run_study(study, o);
+  EXPECT_EQ(r.done, 3u) << r.first_failure;
+  const auto rows = test::dump_rows(dir / "s.db", "SELECT c.status, c.stop_reason, c.steps, c.threads, "
+                                                  "s.particle_count > 0, c.peak_rss_bytes > 0, c.particle_steps > 0 "
+                                                  "FROM cases c JOIN summaries s USING (case_id) ORDER BY case_index");
+  ASSERT_EQ(rows.size(), 3u);
+  for (const auto& row : rows) EXPECT_EQ(row, "done|max_steps|300|1|1|1|1");
+  // Deterministic with one engine thread per case: a second database holds the same results.
+  RunnerOptions o2 = o;
+  o2.db_path = dir / "t.db";
+  o2.jobs = 1;
+  run_study(study, o2);
+  EXPECT_EQ(test::result_dump(dir / "s.db"), test::result_dump(dir / "t.db"));
+}
+
+}  // namespace
+}  // namespace crevasse
