@@ -101,7 +101,10 @@ inline std::vector<std::string> dump_rows(const std::filesystem::path& db, const
   std::vector<std::string> rows;
   while (s.step()) {
     std::string row;
-    for (int c = 0; c < s.columns(); ++c) row += (c ? "|" : "") + (s.is_null(c) ? std::string("NULL") : s.text(c));
+    for (int c = 0; c < s.columns(); ++c) {
+      if (c) row += '|';
+      row += s.is_null(c) ? std::string("NULL") : s.text(c);
+    }
     rows.push_back(row);
   }
   return rows;
