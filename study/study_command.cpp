@@ -12,6 +12,13 @@
 namespace crevasse {
 namespace {
 
+std::string case_wall(double s) {
+  if (s >= 60) return format_duration(s);
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1fs", s);
+  return buf;
+}
+
 class ConsoleObserver : public StudyObserver {
  public:
   ConsoleObserver(std::string name, std::string db) : name_(std::move(name)), db_(std::move(db)) {}
@@ -37,10 +44,10 @@ class ConsoleObserver : public StudyObserver {
                       m.crevasses.size(), m.spacing_over_h ? fmt(m.spacing_over_h->median).c_str() : "-",
                       m.depth_over_h ? fmt(m.depth_over_h->median).c_str() : "-");
       std::fprintf(stderr, "[%zu/%zu] done   %s: %s%s (%s)\n", finished, p.total, c.label.c_str(), stats,
-                   m.flags.fragmented ? ", fragmented" : "", format_duration(r.wall_s).c_str());
+                   m.flags.fragmented ? ", fragmented" : "", case_wall(r.wall_s).c_str());
     } else if (r.status == "done") {
       std::fprintf(stderr, "[%zu/%zu] done   %s (%s)\n", finished, p.total, c.label.c_str(),
-                   format_duration(r.wall_s).c_str());
+                   case_wall(r.wall_s).c_str());
     } else {
       std::fprintf(stderr, "[%zu/%zu] FAILED %s: %s\n", finished, p.total, c.label.c_str(), r.failure_reason.c_str());
     }
