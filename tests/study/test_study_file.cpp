@@ -257,3 +257,39 @@ TEST(Shard, ParsesAndRefuses) {
 
 }  // namespace
 }  // namespace crevasse
+
+namespace crevasse {
+namespace {
+
+// Every study shipped in studies/ loads, and quick.json spans weak to strong ice in 2D.
+TEST(ShippedStudies, AllLoadAndQuickSpansWeakToStrongIce) {
+  const std::filesystem::path dir = std::filesystem::path(CREVASSE_SOURCE_DIR) / "studies";
+  for (const char* name : {"quick", "spacing_vs_cohesion", "slope", "step_length", "three_d", "accuracy_cost"}) {
+    SCOPED_TRACE(name);
+    const Study s = load_study_file(dir / (std::string(name) + ".json"));
+    EXPECT_EQ(s.name, name);
+    EXPECT_FALSE(s.cases.empty());
+  }
+  const Study quick = load_study_file(dir / "quick.json");
+  double lo = 1e9, hi = 0;
+  for (const auto& c : quick.cases) {
+    EXPECT_EQ(c.scene.dim, 2);
+    EXPECT_LE(c.scene.ice_thickness, 100.0);
+    lo = std::min(lo, c.groups.cohesion_ratio);
+    hi = std::max(hi, c.groups.cohesion_ratio);
+  }
+  EXPECT_LE(lo, 0.06);
+  EXPECT_GE(hi, 0.9);
+  EXPECT_LE(quick.cases.size(), 12u);
+  // three_d runs at cohesion ratios of quick's cases.
+  const Study three = load_study_file(dir / "three_d.json");
+  for (const auto& c : three.cases) {
+    EXPECT_EQ(c.scene.dim, 3);
+    bool matched = false;
+    for (const auto& q : quick.cases) matched = matched || q.scene.tensile_strength == c.scene.tensile_strength;
+    EXPECT_TRUE(matched) << c.label;
+  }
+}
+
+}  // namespace
+}  // namespace crevasse
