@@ -27,8 +27,8 @@ void check_finite(const ParticleSnapshot& s) {
     const bool ok = std::isfinite(s.x[i]) && std::isfinite(s.z[i]) && std::isfinite(s.eps_v_p[i]) &&
                     (s.y.empty() || std::isfinite(s.y[i]));
     if (!ok)
-      throw SimulationError("non-finite state of particle " + std::to_string(i) + " at the end of the run (t = " +
-                            std::to_string(s.time_s) + " s)");
+      throw SimulationError("non-finite state of particle " + std::to_string(i) +
+                            " at the end of the run (t = " + std::to_string(s.time_s) + " s)");
   }
 }
 
@@ -39,8 +39,9 @@ CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx) {
   scene.vtu_interval = 0.0;
   scene.png = false;
   if (ctx.time_limit_s() > 0)
-    scene.wall_time_limit = scene.wall_time_limit > 0 ? std::min(scene.wall_time_limit, ctx.time_limit_s())
-                                                      : ctx.time_limit_s();
+    scene.wall_time_limit = scene.wall_time_limit > 0
+                                ? std::min(scene.wall_time_limit, ctx.time_limit_s())
+                                : ctx.time_limit_s();
   CaseObserver observer(ctx);
   RunSummary r = run_scene(scene, &observer);
 
@@ -54,12 +55,14 @@ CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx) {
   out.steps = r.steps;
   out.particle_steps = r.particle_steps;
   out.sim_time_s = r.sim_time_s;
-  out.result_extra = {{"initial_mass_kg", r.initial_mass},       {"final_mass_kg", r.final_mass},
-                      {"removed_mass_kg", r.removed_mass},       {"initial_particles", r.initial_particles},
-                      {"final_particles", r.final_particles},    {"return_map_evaluations", r.return_map_evaluations}};
+  out.result_extra = {
+      {"initial_mass_kg", r.initial_mass},    {"final_mass_kg", r.final_mass},
+      {"removed_mass_kg", r.removed_mass},    {"initial_particles", r.initial_particles},
+      {"final_particles", r.final_particles}, {"return_map_evaluations", r.return_map_evaluations}};
   out.run_json = {{"engine_wall_s", r.wall_s},
                   {"stage_seconds", r.stage_seconds},
-                  {"particle_steps_per_s", r.wall_s > 0 ? static_cast<double>(r.particle_steps) / r.wall_s : 0.0}};
+                  {"particle_steps_per_s",
+                   r.wall_s > 0 ? static_cast<double>(r.particle_steps) / r.wall_s : 0.0}};
   try {
     out.measurement = analysis::measure_crevasses(r.final_snapshot, ctx.measurement());
   } catch (const std::invalid_argument& e) {

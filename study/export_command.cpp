@@ -32,9 +32,11 @@ std::string json_scalar(const nlohmann::json& v) {
 }
 
 // Leaves of a JSON object as "prefix.a.b" → value; arrays are kept as JSON text.
-void flatten(const nlohmann::json& j, const std::string& prefix, std::map<std::string, std::string>& out) {
+void flatten(const nlohmann::json& j, const std::string& prefix,
+             std::map<std::string, std::string>& out) {
   if (j.is_object()) {
-    for (auto it = j.begin(); it != j.end(); ++it) flatten(it.value(), prefix + "." + it.key(), out);
+    for (auto it = j.begin(); it != j.end(); ++it)
+      flatten(it.value(), prefix + "." + it.key(), out);
   } else {
     out[prefix] = json_scalar(j);
   }
@@ -51,7 +53,8 @@ class CsvFile {
   }
   void close() {
     out_.close();
-    if (!out_) throw std::runtime_error("--csv: writing " + path_.string() + " failed (disk full?)");
+    if (!out_)
+      throw std::runtime_error("--csv: writing " + path_.string() + " failed (disk full?)");
   }
 
  private:
@@ -100,7 +103,8 @@ void export_cases(sqlite3* db, const fs::path& path) {
     std::map<std::string, std::string> f;
     const auto axes = nlohmann::json::parse(s.text(axes_col), nullptr, false);
     if (axes.is_object())
-      for (auto it = axes.begin(); it != axes.end(); ++it) f["axis." + it.key()] = json_scalar(it.value());
+      for (auto it = axes.begin(); it != axes.end(); ++it)
+        f["axis." + it.key()] = json_scalar(it.value());
     const auto scene = nlohmann::json::parse(s.text(scene_col), nullptr, false);
     if (!scene.is_discarded()) flatten(scene, "scene", f);
     for (const auto& [k, v] : f)
@@ -128,7 +132,8 @@ std::vector<fs::path> export_csv(const fs::path& db_path, const fs::path& dir) {
   Store store = Store::open_reader(db_path);
   std::error_code ec;
   fs::create_directories(dir, ec);
-  if (ec) throw InputError("--csv: cannot create directory " + dir.string() + " (" + ec.message() + ")");
+  if (ec)
+    throw InputError("--csv: cannot create directory " + dir.string() + " (" + ec.message() + ")");
   std::vector<fs::path> files;
   // One read transaction, so that the files agree with each other while a study is running.
   store.exec("BEGIN");

@@ -14,7 +14,8 @@ struct ExportCommandOptions {
 };
 
 // Returns the files written.
-std::vector<std::filesystem::path> export_csv(const std::filesystem::path& db, const std::filesystem::path& dir);
+std::vector<std::filesystem::path> export_csv(const std::filesystem::path& db,
+                                              const std::filesystem::path& dir);
 
 int export_command(const ExportCommandOptions& opt);
 

@@ -20,7 +20,8 @@ struct CaseState {
 
 std::map<std::string, CaseState> case_states(Store& store, const std::string& schema) {
   std::map<std::string, CaseState> out;
-  Statement s(store.handle(), "SELECT case_id, status, coalesce(result_hash, ''), label FROM " + schema + ".cases");
+  Statement s(store.handle(),
+              "SELECT case_id, status, coalesce(result_hash, ''), label FROM " + schema + ".cases");
   while (s.step()) out[s.text(0)] = {s.text(1), s.text(2), s.text(3)};
   return out;
 }
@@ -34,12 +35,13 @@ void copy_case(Store& store, const std::string& case_id) {
     d.run();
   }
   for (const char* table : {"cases", "crevasses", "summaries"}) {
-    Statement i(store.handle(),
-                std::string("INSERT INTO main.") + table + " SELECT * FROM src." + table + " WHERE case_id = ?");
+    Statement i(store.handle(), std::string("INSERT INTO main.") + table + " SELECT * FROM src." +
+                                    table + " WHERE case_id = ?");
     i.bind(1, case_id);
     i.run();
   }
-  Statement p(store.handle(), "UPDATE main.cases SET status = 'pending' WHERE case_id = ? AND status = 'running'");
+  Statement p(store.handle(),
+              "UPDATE main.cases SET status = 'pending' WHERE case_id = ? AND status = 'running'");
   p.bind(1, case_id);
   p.run();
 }
@@ -51,7 +53,8 @@ MergeReport merge_databases(const fs::path& out, const std::vector<fs::path>& in
   std::error_code ec;
   for (const auto& in : inputs) {
     if (fs::exists(out) && fs::equivalent(in, out, ec))
-      throw InputError("merge: input " + in.string() + " is the output database; give a new OUT path");
+      throw InputError("merge: input " + in.string() +
+                       " is the output database; give a new OUT path");
     Store::open_reader(in);  // exists and is a study database of this schema
   }
   MergeReport report;
@@ -77,12 +80,14 @@ MergeReport merge_databases(const fs::path& out, const std::vector<fs::path>& in
           if (*mine != *src_hash) {
             Statement s(store.handle(), "SELECT name FROM main.study WHERE id = 1");
             s.step();
-            throw InputError(in.string() + ": holds study '" + *src_name + "', not the study '" + s.text(0) +
-                             "' already in " + out.string() + " (other cases or engine version); merge only "
+            throw InputError(in.string() + ": holds study '" + *src_name + "', not the study '" +
+                             s.text(0) + "' already in " + out.string() +
+                             " (other cases or engine version); merge only "
                              "databases of one study");
           }
           store.exec(
-              "UPDATE main.study SET ended_at = (SELECT nullif(max(coalesce(a.ended_at, ''), coalesce(b.ended_at, '')), '') "
+              "UPDATE main.study SET ended_at = (SELECT nullif(max(coalesce(a.ended_at, ''), "
+              "coalesce(b.ended_at, '')), '') "
               "FROM main.study a, src.study b) WHERE id = 1");
         } else {
           store.exec("INSERT INTO main.study SELECT * FROM src.study");
@@ -104,10 +109,11 @@ MergeReport merge_databases(const fs::path& out, const std::vector<fs::path>& in
             continue;
           }
           ++report.conflicts;
-          std::string line = "case " + id.substr(0, 12) + " (" + src.label + "): " + out.filename().string() +
-                             " has " + dst.status + " (result " + dst.result_hash.substr(0, 12) + "), " +
-                             in.filename().string() + " has " + src.status + " (result " +
-                             src.result_hash.substr(0, 12) + ")";
+          std::string line = "case " + id.substr(0, 12) + " (" + src.label +
+                             "): " + out.filename().string() + " has " + dst.status + " (result " +
+                             dst.result_hash.substr(0, 12) + "), " + in.filename().string() +
+                             " has " + src.status + " (result " + src.result_hash.substr(0, 12) +
+                             ")";
           if (dst.status == "failed" && src.status == "done") {
             copy_case(store, id);
             line += "; kept the finished result from " + in.filename().string();
@@ -134,11 +140,13 @@ int merge_command(const std::string& out, const std::vector<std::string>& inputs
   for (const auto& line : r.conflict_lines) std::fprintf(stderr, "conflict: %s\n", line.c_str());
   Store store = Store::open_reader(out);
   const StatusCounts c = store.counts();
-  std::printf("merged %zu database(s) into %s: %zu case(s) copied, %zu identical, %zu conflict(s); now %lld done, "
-              "%lld failed, %lld pending of %lld\n",
-              r.inputs, out.c_str(), r.copied, r.identical, r.conflicts, static_cast<long long>(c.done),
-              static_cast<long long>(c.failed), static_cast<long long>(c.pending + c.running),
-              static_cast<long long>(c.total()));
+  std::printf(
+      "merged %zu database(s) into %s: %zu case(s) copied, %zu identical, %zu conflict(s); now "
+      "%lld done, "
+      "%lld failed, %lld pending of %lld\n",
+      r.inputs, out.c_str(), r.copied, r.identical, r.conflicts, static_cast<long long>(c.done),
+      static_cast<long long>(c.failed), static_cast<long long>(c.pending + c.running),
+      static_cast<long long>(c.total()));
   return r.conflicts > 0 ? 1 : 0;
 }
 

@@ -18,7 +18,8 @@ struct MergeReport {
 };
 
 // Throws InputError when an input is missing, is OUT itself, or holds another study.
-MergeReport merge_databases(const std::filesystem::path& out, const std::vector<std::filesystem::path>& inputs);
+MergeReport merge_databases(const std::filesystem::path& out,
+                            const std::vector<std::filesystem::path>& inputs);
 
 // The CLI command: prints the report; returns 0, or 1 when there were conflicts.
 int merge_command(const std::string& out, const std::vector<std::string>& inputs);

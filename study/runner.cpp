@@ -57,12 +57,9 @@ std::string host_name() {
 }
 
 nlohmann::json deterministic_result(const CaseOutcome& o) {
-  nlohmann::json j = {{"status", "done"},
-                      {"stop_reason", o.stop_reason},
-                      {"steps", o.steps},
-                      {"particle_steps", o.particle_steps},
-                      {"sim_time_s", o.sim_time_s},
-                      {"extra", o.result_extra}};
+  nlohmann::json j = {{"status", "done"},           {"stop_reason", o.stop_reason},
+                      {"steps", o.steps},           {"particle_steps", o.particle_steps},
+                      {"sim_time_s", o.sim_time_s}, {"extra", o.result_extra}};
   if (o.measurement) j["measurement"] = analysis::measurement_summary_json(*o.measurement);
   return j;
 }
@@ -95,7 +92,8 @@ class EventQueue {
   std::pair<std::vector<Event>, bool> take(std::chrono::milliseconds timeout) {
     std::unique_lock lock(mutex_);
     cv_.wait_for(lock, timeout, [&] { return !events_.empty() || closed_; });
-    std::vector<Event> out(std::make_move_iterator(events_.begin()), std::make_move_iterator(events_.end()));
+    std::vector<Event> out(std::make_move_iterator(events_.begin()),
+                           std::make_move_iterator(events_.end()));
     events_.clear();
     return {std::move(out), closed_};
   }
@@ -114,7 +112,8 @@ int default_jobs(int threads_per_case) {
   return std::max(1, cores / std::max(1, threads_per_case));
 }
 
-CaseContext::CaseContext(int threads, double time_limit_s, const analysis::MeasureSettings& measurement,
+CaseContext::CaseContext(int threads, double time_limit_s,
+                         const analysis::MeasureSettings& measurement,
                          const std::atomic<bool>& stop, std::atomic<double>& fraction)
     : threads_(threads),
       time_limit_s_(time_limit_s),
@@ -125,19 +124,23 @@ CaseContext::CaseContext(int threads, double time_limit_s, const analysis::Measu
 
 double CaseContext::elapsed_s() const { return seconds_since(start_); }
 
-bool CaseContext::time_limit_exceeded() const { return time_limit_s_ > 0 && elapsed_s() > time_limit_s_; }
+bool CaseContext::time_limit_exceeded() const {
+  return time_limit_s_ > 0 && elapsed_s() > time_limit_s_;
+}
 
 RunnerReport run_study(const Study& study, const RunnerOptions& opt) {
   const auto t0 = clock_type::now();
   RunnerReport report;
-  report.threads_per_case = opt.threads_per_case > 0                ? opt.threads_per_case
-                            : study.resources.threads_per_case > 0 ? study.resources.threads_per_case
-                                                                    : kDefaultThreadsPerCase;
-  report.jobs = opt.jobs > 0                 ? opt.jobs
+  report.threads_per_case = opt.threads_per_case > 0 ? opt.threads_per_case
+                            : study.resources.threads_per_case > 0
+                                ? study.resources.threads_per_case
+                                : kDefaultThreadsPerCase;
+  report.jobs = opt.jobs > 0               ? opt.jobs
                 : study.resources.jobs > 0 ? study.resources.jobs
                                            : default_jobs(report.threads_per_case);
   const double time_limit = opt.case_time_limit_s.value_or(study.resources.case_time_limit_s);
-  const CaseFunction case_function = opt.case_function ? opt.case_function : CaseFunction(run_engine_case);
+  const CaseFunction case_function =
+      opt.case_function ? opt.case_function : CaseFunction(run_engine_case);
 
   // Everything that can refuse the run does so before a case starts.
   Store store = Store::open_writer(opt.db_path);
@@ -167,9 +170,12 @@ RunnerReport run_study(const Study& study, const RunnerOptions& opt) {
   std::vector<const StudyCase*> todo;
   for (const StudyCase* c : scope) {
     const std::string& s = status.at(c->case_id);
-    if (s == "done") ++report.already_done;
-    else if (s == "failed" && !opt.retry_failed) ++report.already_failed;
-    else todo.push_back(c);
+    if (s == "done")
+      ++report.already_done;
+    else if (s == "failed" && !opt.retry_failed)
+      ++report.already_failed;
+    else
+      todo.push_back(c);
   }
 
   RunnerProgress progress;
@@ -181,9 +187,11 @@ RunnerReport run_study(const Study& study, const RunnerOptions& opt) {
 
   // Workers: `jobs` loops in one arena, each taking the next case; each case runs in its own
   // arena so that the engine's parallel loops use exactly threads_per_case threads.
-  const int jobs = std::max(1, std::min<int>(report.jobs, static_cast<int>(std::max<std::size_t>(todo.size(), 1))));
-  tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism,
-                                  static_cast<std::size_t>(std::max(1, jobs * report.threads_per_case)));
+  const int jobs = std::max(
+      1, std::min<int>(report.jobs, static_cast<int>(std::max<std::size_t>(todo.size(), 1))));
+  tbb::global_control parallelism(
+      tbb::global_control::max_allowed_parallelism,
+      static_cast<std::size_t>(std::max(1, jobs * report.threads_per_case)));
   std::atomic<bool> stop{false};
   std::atomic<std::size_t> next{0};
   std::vector<std::atomic<double>> fraction(todo.size());
@@ -224,7 +232,8 @@ RunnerReport run_study(const Study& study, const RunnerOptions& opt) {
           queue.push(Event{Event::Kind::cancelled, slot, {}, started_at});
           continue;
         }
-        failure = "time limit: the case ran longer than the case time limit of " + std::to_string(time_limit) + " s";
+        failure = "time limit: the case ran longer than the case time limit of " +
+                  std::to_string(time_limit) + " s";
       }
       CaseResult r;
       r.case_id = c.case_id;
@@ -330,7 +339,8 @@ RunnerReport run_study(const Study& study, const RunnerOptions& opt) {
             } else {
               ++report.failed;
               ++progress.failed;
-              if (report.first_failure.empty()) report.first_failure = c.label + ": " + e.result.failure_reason;
+              if (report.first_failure.empty())
+                report.first_failure = c.label + ": " + e.result.failure_reason;
             }
             progress.running = running.size();
             progress.elapsed_s = seconds_since(t0);
@@ -354,7 +364,9 @@ RunnerReport run_study(const Study& study, const RunnerOptions& opt) {
 
   report.stopped = opt.fail_fast && report.failed > 0;
   report.wall_s = seconds_since(t0);
-  const std::string outcome = report.stopped ? "stopped" : report.failed + report.already_failed > 0 ? "failures" : "complete";
+  const std::string outcome = report.stopped                              ? "stopped"
+                              : report.failed + report.already_failed > 0 ? "failures"
+                                                                          : "complete";
   store.end_session(session_id, outcome, static_cast<std::int64_t>(report.ran));
   store.checkpoint();
   if (opt.observer) opt.observer->on_end(report);

@@ -31,8 +31,9 @@ struct CaseOutcome {
   std::int64_t steps = 0;
   std::int64_t particle_steps = 0;
   double sim_time_s = 0.0;
-  nlohmann::json run_json = nlohmann::json::object();      // timings and other non-deterministic data
-  nlohmann::json result_extra = nlohmann::json::object();  // deterministic data beyond the measurement
+  nlohmann::json run_json = nlohmann::json::object();  // timings and other non-deterministic data
+  nlohmann::json result_extra =
+      nlohmann::json::object();  // deterministic data beyond the measurement
   std::optional<analysis::CrevasseMeasurement> measurement;
 };
 
@@ -75,8 +76,8 @@ struct RunnerReport {
   std::size_t already_failed = 0;  // stored as failed before this run and not retried
   std::size_t interrupted = 0;     // left 'running' by a killed run, run again
   std::size_t ran = 0, done = 0, failed = 0, cancelled = 0;
-  bool stopped = false;            // --fail-fast stopped the run
-  std::string first_failure;       // "label: reason"
+  bool stopped = false;       // --fail-fast stopped the run
+  std::string first_failure;  // "label: reason"
   double wall_s = 0.0;
   int jobs = 0, threads_per_case = 0;
   std::string session_id;
@@ -93,14 +94,14 @@ class StudyObserver {
 
 struct RunnerOptions {
   std::filesystem::path db_path;
-  int jobs = 0;                              // 0: resources.jobs, else default_jobs()
-  int threads_per_case = 0;                  // 0: resources.threads_per_case, else kDefault…
-  std::optional<double> case_time_limit_s;   // overrides resources.case_time_limit_s
+  int jobs = 0;                             // 0: resources.jobs, else default_jobs()
+  int threads_per_case = 0;                 // 0: resources.threads_per_case, else kDefault…
+  std::optional<double> case_time_limit_s;  // overrides resources.case_time_limit_s
   bool fail_fast = false;
-  bool retry_failed = false;                 // run cases stored as failed again
+  bool retry_failed = false;  // run cases stored as failed again
   std::optional<Shard> shard;
-  std::string command;                       // recorded in the sessions table
-  CaseFunction case_function;                // empty: run_engine_case (engine_case.hpp)
+  std::string command;         // recorded in the sessions table
+  CaseFunction case_function;  // empty: run_engine_case (engine_case.hpp)
   StudyObserver* observer = nullptr;
 };
 

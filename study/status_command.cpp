@@ -31,8 +31,10 @@ int status_command(const StatusCommandOptions& opt) {
   Store store = Store::open_reader(opt.db_path);
   sqlite3* db = store.handle();
   {
-    Statement s(db, "SELECT name, case_count, engine_version, host, started_at, coalesce(ended_at, '-'), description "
-                    "FROM study WHERE id = 1");
+    Statement s(db,
+                "SELECT name, case_count, engine_version, host, started_at, coalesce(ended_at, "
+                "'-'), description "
+                "FROM study WHERE id = 1");
     if (!s.step()) {
       std::printf("%s: no study recorded yet\n", opt.db_path.c_str());
       return 0;
@@ -40,57 +42,73 @@ int status_command(const StatusCommandOptions& opt) {
     std::printf("study %s: %lld cases, engine %s, database %s\n", s.text(0).c_str(),
                 static_cast<long long>(s.integer(1)), s.text(2).c_str(), opt.db_path.c_str());
     if (!s.text(6).empty()) std::printf("  %s\n", s.text(6).c_str());
-    std::printf("  created %s on %s, last session ended %s\n", s.text(4).c_str(), s.text(3).c_str(), s.text(5).c_str());
+    std::printf("  created %s on %s, last session ended %s\n", s.text(4).c_str(), s.text(3).c_str(),
+                s.text(5).c_str());
   }
   const StatusCounts c = store.counts();
   {
-    Statement s(db, "SELECT coalesce(sum(wall_s), 0), coalesce(sum(particle_steps), 0) FROM cases "
-                    "WHERE status IN ('done', 'failed')");
+    Statement s(db,
+                "SELECT coalesce(sum(wall_s), 0), coalesce(sum(particle_steps), 0) FROM cases "
+                "WHERE status IN ('done', 'failed')");
     s.step();
-    std::printf("  in this database: %lld done, %lld failed, %lld running, %lld pending (of %lld); %s of case "
-                "wall time, %.3g particle-steps\n",
-                static_cast<long long>(c.done), static_cast<long long>(c.failed), static_cast<long long>(c.running),
-                static_cast<long long>(c.pending), static_cast<long long>(c.total()),
-                format_duration(s.real(0)).c_str(), s.real(1));
+    std::printf(
+        "  in this database: %lld done, %lld failed, %lld running, %lld pending (of %lld); %s of "
+        "case "
+        "wall time, %.3g particle-steps\n",
+        static_cast<long long>(c.done), static_cast<long long>(c.failed),
+        static_cast<long long>(c.running), static_cast<long long>(c.pending),
+        static_cast<long long>(c.total()), format_duration(s.real(0)).c_str(), s.real(1));
   }
   {
     Statement s(db, "SELECT count(*), coalesce(sum(outcome IS NULL), 0) FROM sessions");
     s.step();
-    Statement last(db, "SELECT session_id, jobs, threads_per_case, shard, coalesce(outcome, 'running or killed') "
-                       "FROM sessions ORDER BY started_at DESC LIMIT 1");
+    Statement last(
+        db,
+        "SELECT session_id, jobs, threads_per_case, shard, coalesce(outcome, 'running or killed') "
+        "FROM sessions ORDER BY started_at DESC LIMIT 1");
     if (last.step())
       std::printf("  sessions: %lld (last %s: %lld jobs x %lld threads%s%s, %s)\n",
-                  static_cast<long long>(s.integer(0)), last.text(0).c_str(), static_cast<long long>(last.integer(1)),
-                  static_cast<long long>(last.integer(2)), last.text(3).empty() ? "" : ", shard ",
-                  last.text(3).c_str(), last.text(4).c_str());
+                  static_cast<long long>(s.integer(0)), last.text(0).c_str(),
+                  static_cast<long long>(last.integer(1)), static_cast<long long>(last.integer(2)),
+                  last.text(3).empty() ? "" : ", shard ", last.text(3).c_str(),
+                  last.text(4).c_str());
   }
   if (c.running > 0) {
     std::printf("running (or interrupted; a resume reruns them):\n");
-    Statement s(db, "SELECT label, started_at, session_id FROM cases WHERE status = 'running' ORDER BY case_index");
+    Statement s(db,
+                "SELECT label, started_at, session_id FROM cases WHERE status = 'running' ORDER BY "
+                "case_index");
     while (s.step())
-      std::printf("  %s  since %s  (%s)\n", s.text(0).c_str(), s.text(1).c_str(), s.text(2).c_str());
+      std::printf("  %s  since %s  (%s)\n", s.text(0).c_str(), s.text(1).c_str(),
+                  s.text(2).c_str());
   }
   if (c.failed > 0) {
     std::printf("failed:\n");
-    Statement s(db, "SELECT label, failure_reason FROM cases WHERE status = 'failed' ORDER BY case_index");
+    Statement s(
+        db, "SELECT label, failure_reason FROM cases WHERE status = 'failed' ORDER BY case_index");
     while (s.step()) std::printf("  %s: %s\n", s.text(0).c_str(), s.text(1).c_str());
   }
   if (c.done > 0) {
     const long long limit = opt.all_cases ? -1 : kDefaultCaseRows;
-    std::printf("done:\n  %5s  %-10s %8s %8s %8s %7s  %5s %9s %9s %8s  %s\n", "index", "case", "H_i[m]", "Pi",
-                "r=Ls/Hi", "S", "crev", "Lp/Hi", "Dp/Hi", "wall", "label");
-    Statement s(db,
-                "SELECT c.case_index, substr(c.case_id, 1, 10), c.thickness_m, c.cohesion_ratio, c.step_length_ratio, "
-                "c.slope, m.crevasse_count, m.spacing_median_over_h, m.depth_median_over_h, c.wall_s, c.label, "
-                "m.fragmented FROM cases c LEFT JOIN summaries m USING (case_id) WHERE c.status = 'done' "
-                "ORDER BY c.case_index LIMIT ?");
+    std::printf("done:\n  %5s  %-10s %8s %8s %8s %7s  %5s %9s %9s %8s  %s\n", "index", "case",
+                "H_i[m]", "Pi", "r=Ls/Hi", "S", "crev", "Lp/Hi", "Dp/Hi", "wall", "label");
+    Statement s(
+        db,
+        "SELECT c.case_index, substr(c.case_id, 1, 10), c.thickness_m, c.cohesion_ratio, "
+        "c.step_length_ratio, "
+        "c.slope, m.crevasse_count, m.spacing_median_over_h, m.depth_median_over_h, c.wall_s, "
+        "c.label, "
+        "m.fragmented FROM cases c LEFT JOIN summaries m USING (case_id) WHERE c.status = 'done' "
+        "ORDER BY c.case_index LIMIT ?");
     s.bind(1, static_cast<std::int64_t>(limit));
     while (s.step()) {
-      std::printf("  %5lld  %-10s %8s %8s %8s %7s  %5lld %9s %9s %8s  %s%s\n", static_cast<long long>(s.integer(0)),
-                  s.text(1).c_str(), cell(s, 2, "%.0f").c_str(), cell(s, 3, "%.4g").c_str(),
-                  cell(s, 4, "%.3g").c_str(), cell(s, 5, "%.3g").c_str(), static_cast<long long>(s.integer(6)),
-                  cell(s, 7, "%.3f").c_str(), cell(s, 8, "%.3f").c_str(), wall(s.real(9)).c_str(),
-                  s.text(10).c_str(), s.integer(11) ? "  (fragmented)" : "");
+      std::printf("  %5lld  %-10s %8s %8s %8s %7s  %5lld %9s %9s %8s  %s%s\n",
+                  static_cast<long long>(s.integer(0)), s.text(1).c_str(),
+                  cell(s, 2, "%.0f").c_str(), cell(s, 3, "%.4g").c_str(),
+                  cell(s, 4, "%.3g").c_str(), cell(s, 5, "%.3g").c_str(),
+                  static_cast<long long>(s.integer(6)), cell(s, 7, "%.3f").c_str(),
+                  cell(s, 8, "%.3f").c_str(), wall(s.real(9)).c_str(), s.text(10).c_str(),
+                  s.integer(11) ? "  (fragmented)" : "");
     }
     if (limit >= 0 && c.done > limit)
       std::printf("  ... %lld more (crevasse status --all, or crevasse export --csv)\n",

@@ -129,7 +129,8 @@ CREATE TABLE IF NOT EXISTS summaries (
 )SQL";
 
 [[noreturn]] void sql_fail(sqlite3* db, const std::string& what) {
-  throw std::runtime_error("database: " + what + ": " + (db ? sqlite3_errmsg(db) : "out of memory"));
+  throw std::runtime_error("database: " + what + ": " +
+                           (db ? sqlite3_errmsg(db) : "out of memory"));
 }
 
 }  // namespace
@@ -142,7 +143,8 @@ Statement::Statement(sqlite3* db, const std::string& sql) : db_(db), sql_(sql) {
 Statement::~Statement() { sqlite3_finalize(stmt_); }
 
 Statement& Statement::bind(int i, const std::string& v) {
-  if (sqlite3_bind_text(stmt_, i, v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT) != SQLITE_OK)
+  if (sqlite3_bind_text(stmt_, i, v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT) !=
+      SQLITE_OK)
     sql_fail(db_, "bind");
   return *this;
 }
@@ -178,7 +180,8 @@ std::string Statement::column_name(int c) const { return sqlite3_column_name(stm
 bool Statement::is_null(int c) const { return sqlite3_column_type(stmt_, c) == SQLITE_NULL; }
 std::string Statement::text(int c) const {
   const auto* p = sqlite3_column_text(stmt_, c);
-  return p ? std::string(reinterpret_cast<const char*>(p), static_cast<std::size_t>(sqlite3_column_bytes(stmt_, c)))
+  return p ? std::string(reinterpret_cast<const char*>(p),
+                         static_cast<std::size_t>(sqlite3_column_bytes(stmt_, c)))
            : std::string();
 }
 double Statement::real(int c) const { return sqlite3_column_double(stmt_, c); }
@@ -194,16 +197,18 @@ std::optional<double> Statement::optional_real(int c) const {
 std::string utc_now_iso8601() {
   const auto now = std::chrono::system_clock::now();
   const std::time_t t = std::chrono::system_clock::to_time_t(now);
-  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
+  const auto ms =
+      std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
   std::tm tm{};
   gmtime_r(&t, &tm);
   char buf[64];
-  std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900, tm.tm_mon + 1,
-                tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec, static_cast<int>(ms));
+  std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900,
+                tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec, static_cast<int>(ms));
   return buf;
 }
 
-Store::Store(sqlite3* db, fs::path path, int lock_fd) : db_(db), path_(std::move(path)), lock_fd_(lock_fd) {}
+Store::Store(sqlite3* db, fs::path path, int lock_fd)
+    : db_(db), path_(std::move(path)), lock_fd_(lock_fd) {}
 
 Store::Store(Store&& o) noexcept : db_(o.db_), path_(std::move(o.path_)), lock_fd_(o.lock_fd_) {
   o.db_ = nullptr;
@@ -244,18 +249,22 @@ Store Store::open_writer(const fs::path& path) {
   std::error_code ec;
   if (path.has_parent_path()) {
     fs::create_directories(path.parent_path(), ec);
-    if (ec) throw InputError(where + ": cannot create directory " + path.parent_path().string() + " (" + ec.message() + ")");
+    if (ec)
+      throw InputError(where + ": cannot create directory " + path.parent_path().string() + " (" +
+                       ec.message() + ")");
   }
   const std::string lock_path = path.string() + ".lock";
   const int fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (fd < 0) throw InputError(where + ": cannot create " + lock_path + " (" + std::strerror(errno) + ")");
+  if (fd < 0)
+    throw InputError(where + ": cannot create " + lock_path + " (" + std::strerror(errno) + ")");
   if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
     ::close(fd);
-    throw InputError(where + ": another crevasse process is writing to this database (" + lock_path +
-                     " is locked); wait for it to end or use another --db");
+    throw InputError(where + ": another crevasse process is writing to this database (" +
+                     lock_path + " is locked); wait for it to end or use another --db");
   }
   sqlite3* db = nullptr;
-  if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr) != SQLITE_OK) {
+  if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr) !=
+      SQLITE_OK) {
     const std::string msg = db ? sqlite3_errmsg(db) : "out of memory";
     sqlite3_close_v2(db);
     ::close(fd);
@@ -266,14 +275,18 @@ Store Store::open_writer(const fs::path& path) {
   try {
     const int version = schema_version(db);
     if (version == 0 && table_count(db) > 0)
-      throw InputError(where + ": this file is an SQLite database but not a crevasse study database");
+      throw InputError(where +
+                       ": this file is an SQLite database but not a crevasse study database");
     if (version > kStoreSchemaVersion)
       throw InputError(where + ": schema version " + std::to_string(version) +
-                       " was written by a newer crevasse (this one reads " + std::to_string(kStoreSchemaVersion) + ")");
+                       " was written by a newer crevasse (this one reads " +
+                       std::to_string(kStoreSchemaVersion) + ")");
     {
       Statement wal(db, "PRAGMA journal_mode = WAL");
       if (!wal.step() || wal.text(0) != "wal")
-        throw InputError(where + ": the database cannot use the WAL journal (is the file system local and writable?)");
+        throw InputError(
+            where +
+            ": the database cannot use the WAL journal (is the file system local and writable?)");
     }
     store.exec("PRAGMA synchronous = FULL");
     store.exec("PRAGMA foreign_keys = ON");
@@ -307,7 +320,8 @@ Store Store::open_reader(const fs::path& path) {
   }
   if (version != kStoreSchemaVersion)
     throw InputError(where + ": not a crevasse study database of schema version " +
-                     std::to_string(kStoreSchemaVersion) + " (found " + std::to_string(version) + ")");
+                     std::to_string(kStoreSchemaVersion) + " (found " + std::to_string(version) +
+                     ")");
   return store;
 }
 
@@ -323,8 +337,9 @@ void Store::init_study(const Study& study) {
       Statement s(db_, "SELECT name, case_count FROM study WHERE id = 1");
       s.step();
       throw InputError("--db " + path_.string() + ": holds study '" + s.text(0) + "' (" +
-                       std::to_string(s.integer(1)) + " cases) with other parameters or engine version than '" +
-                       study.name + "' (" + std::to_string(study.cases.size()) +
+                       std::to_string(s.integer(1)) +
+                       " cases) with other parameters or engine version than '" + study.name +
+                       "' (" + std::to_string(study.cases.size()) +
                        " cases); use another --db for the changed study");
     }
     return;
@@ -332,8 +347,10 @@ void Store::init_study(const Study& study) {
   char host[256] = "unknown";
   gethostname(host, sizeof host - 1);
   Statement s(db_,
-              "INSERT INTO study (id, name, description, study_hash, case_count, file_text, base_scene_json, "
-              "measurement_json, engine_version, host, started_at) VALUES (1, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+              "INSERT INTO study (id, name, description, study_hash, case_count, file_text, "
+              "base_scene_json, "
+              "measurement_json, engine_version, host, started_at) VALUES (1, ?, ?, ?, ?, ?, ?, ?, "
+              "?, ?, ?)");
   s.bind(1, study.name)
       .bind(2, study.description)
       .bind(3, study.study_hash)
@@ -349,17 +366,20 @@ void Store::init_study(const Study& study) {
 
 void Store::begin_session(const SessionInfo& x) {
   Statement s(db_,
-              "INSERT INTO sessions (session_id, host, pid, started_at, jobs, threads_per_case, shard, command) "
+              "INSERT INTO sessions (session_id, host, pid, started_at, jobs, threads_per_case, "
+              "shard, command) "
               "VALUES (?, ?, ?, ?, ?, ?, ?, ?)");
   s.bind(1, x.session_id).bind(2, x.host).bind(3, x.pid).bind(4, x.started_at).bind(5, x.jobs);
   s.bind(6, x.threads_per_case).bind(7, x.shard).bind(8, x.command);
   s.run();
 }
 
-void Store::end_session(const std::string& session_id, const std::string& outcome, std::int64_t cases_run) {
+void Store::end_session(const std::string& session_id, const std::string& outcome,
+                        std::int64_t cases_run) {
   const std::string now = utc_now_iso8601();
   transaction([&] {
-    Statement s(db_, "UPDATE sessions SET ended_at = ?, outcome = ?, cases_run = ? WHERE session_id = ?");
+    Statement s(
+        db_, "UPDATE sessions SET ended_at = ?, outcome = ?, cases_run = ? WHERE session_id = ?");
     s.bind(1, now).bind(2, outcome).bind(3, cases_run).bind(4, session_id);
     s.run();
     Statement e(db_, "UPDATE study SET ended_at = ? WHERE id = 1");
@@ -370,20 +390,32 @@ void Store::end_session(const std::string& session_id, const std::string& outcom
 
 void Store::add_cases(const std::vector<const StudyCase*>& cases) {
   transaction([&] {
-    Statement s(db_,
-                "INSERT OR IGNORE INTO cases (case_id, case_index, label, replica, status, thickness_m, "
-                "cohesion_ratio, step_length_ratio, step_height_ratio, slope, width_ratio, tensile_strength_pa, "
-                "step_length_m, step_height_m, width_m, dx_m, dim, seed, axes_json, scene_json, engine_version) "
-                "VALUES (?, ?, ?, ?, 'pending', ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+    Statement s(
+        db_,
+        "INSERT OR IGNORE INTO cases (case_id, case_index, label, replica, status, thickness_m, "
+        "cohesion_ratio, step_length_ratio, step_height_ratio, slope, width_ratio, "
+        "tensile_strength_pa, "
+        "step_length_m, step_height_m, width_m, dx_m, dim, seed, axes_json, scene_json, "
+        "engine_version) "
+        "VALUES (?, ?, ?, ?, 'pending', ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
     for (const StudyCase* c : cases) {
       const SceneConfig& sc = c->scene;
-      s.bind(1, c->case_id).bind(2, static_cast<std::int64_t>(c->index)).bind(3, c->label).bind(4, c->replica);
-      s.bind(5, c->groups.thickness_m).bind(6, c->groups.cohesion_ratio).bind(7, c->groups.step_length_ratio);
-      s.bind(8, c->groups.step_height_ratio).bind(9, c->groups.slope).bind(10, c->groups.width_ratio);
+      s.bind(1, c->case_id)
+          .bind(2, static_cast<std::int64_t>(c->index))
+          .bind(3, c->label)
+          .bind(4, c->replica);
+      s.bind(5, c->groups.thickness_m)
+          .bind(6, c->groups.cohesion_ratio)
+          .bind(7, c->groups.step_length_ratio);
+      s.bind(8, c->groups.step_height_ratio)
+          .bind(9, c->groups.slope)
+          .bind(10, c->groups.width_ratio);
       s.bind(11, sc.tensile_strength).bind(12, sc.step_length).bind(13, sc.step_height);
       s.bind(14, sc.dim == 3 ? std::optional<double>(sc.width) : std::nullopt);
       s.bind(15, sc.dx).bind(16, sc.dim).bind(17, static_cast<std::int64_t>(sc.seed));
-      s.bind(18, c->axes.dump()).bind(19, c->scene_json.dump()).bind(20, std::string(CREVASSE_ENGINE_VERSION));
+      s.bind(18, c->axes.dump())
+          .bind(19, c->scene_json.dump())
+          .bind(20, std::string(CREVASSE_ENGINE_VERSION));
       s.run();
     }
   });
@@ -394,8 +426,8 @@ std::int64_t Store::reset_running() {
   return sqlite3_changes(db_);
 }
 
-void Store::mark_running(const std::string& case_id, const std::string& session_id, const std::string& started_at,
-                         int threads) {
+void Store::mark_running(const std::string& case_id, const std::string& session_id,
+                         const std::string& started_at, int threads) {
   Statement s(db_,
               "UPDATE cases SET status = 'running', session_id = ?, started_at = ?, threads = ?, "
               "attempts = attempts + 1 WHERE case_id = ?");
@@ -413,8 +445,10 @@ void Store::record_result(const CaseResult& r) {
   const std::string result_text = r.result_json.dump();
   transaction([&] {
     Statement u(db_,
-                "UPDATE cases SET status = ?, failure_reason = ?, stop_reason = ?, session_id = ?, started_at = ?, "
-                "finished_at = ?, wall_s = ?, peak_rss_bytes = ?, threads = ?, steps = ?, particle_steps = ?, "
+                "UPDATE cases SET status = ?, failure_reason = ?, stop_reason = ?, session_id = ?, "
+                "started_at = ?, "
+                "finished_at = ?, wall_s = ?, peak_rss_bytes = ?, threads = ?, steps = ?, "
+                "particle_steps = ?, "
                 "sim_time_s = ?, run_json = ?, result_json = ?, result_hash = ? WHERE case_id = ?");
     u.bind(1, r.status);
     u.bind(2, r.status == "failed" ? std::optional<std::string>(r.failure_reason) : std::nullopt);
@@ -424,7 +458,8 @@ void Store::record_result(const CaseResult& r) {
     u.bind(12, r.sim_time_s).bind(13, r.run_json.dump()).bind(14, result_text);
     u.bind(15, sha256_hex(result_text)).bind(16, r.case_id);
     u.run();
-    if (sqlite3_changes(db_) != 1) throw std::runtime_error("database: case " + r.case_id + " is not in the cases table");
+    if (sqlite3_changes(db_) != 1)
+      throw std::runtime_error("database: case " + r.case_id + " is not in the cases table");
     Statement dc(db_, "DELETE FROM crevasses WHERE case_id = ?");
     dc.bind(1, r.case_id);
     dc.run();
@@ -435,30 +470,44 @@ void Store::record_result(const CaseResult& r) {
     const analysis::CrevasseMeasurement& m = *r.measurement;
     const double h = m.settings.ice_thickness_m;
     Statement ic(db_,
-                 "INSERT INTO crevasses (case_id, crevasse_index, x_m, surface_z_m, bottom_z_m, depth_m, depth_over_h, "
+                 "INSERT INTO crevasses (case_id, crevasse_index, x_m, surface_z_m, bottom_z_m, "
+                 "depth_m, depth_over_h, "
                  "width_m, spacing_to_next_m, spacing_over_h, particle_count, merged_count) "
                  "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
     for (std::size_t i = 0; i < m.crevasses.size(); ++i) {
       const analysis::Crevasse& c = m.crevasses[i];
-      ic.bind(1, r.case_id).bind(2, static_cast<std::int64_t>(i)).bind(3, c.x_m).bind(4, c.surface_z_m);
-      ic.bind(5, c.bottom_z_m).bind(6, c.depth_m).bind(7, h > 0 ? c.depth_m / h : 0.0).bind(8, c.width_m);
+      ic.bind(1, r.case_id)
+          .bind(2, static_cast<std::int64_t>(i))
+          .bind(3, c.x_m)
+          .bind(4, c.surface_z_m);
+      ic.bind(5, c.bottom_z_m)
+          .bind(6, c.depth_m)
+          .bind(7, h > 0 ? c.depth_m / h : 0.0)
+          .bind(8, c.width_m);
       ic.bind(9, c.spacing_to_next_m);
-      ic.bind(10, c.spacing_to_next_m && h > 0 ? std::optional<double>(*c.spacing_to_next_m / h) : std::nullopt);
-      ic.bind(11, static_cast<std::int64_t>(c.particle_count)).bind(12, static_cast<std::int64_t>(c.merged_count));
+      ic.bind(10, c.spacing_to_next_m && h > 0 ? std::optional<double>(*c.spacing_to_next_m / h)
+                                               : std::nullopt);
+      ic.bind(11, static_cast<std::int64_t>(c.particle_count))
+          .bind(12, static_cast<std::int64_t>(c.merged_count));
       ic.run();
     }
-    auto q = [](const std::optional<analysis::QuartileSummary>& s, int which) -> std::optional<double> {
+    auto q = [](const std::optional<analysis::QuartileSummary>& s,
+                int which) -> std::optional<double> {
       if (!s) return std::nullopt;
       return which == 0 ? s->q25 : which == 1 ? s->median : s->q75;
     };
-    Statement is(db_,
-                 "INSERT INTO summaries (case_id, measurement_time_s, crevasse_count, spacing_count, "
-                 "dropped_spacing_count, spacing_q25_m, spacing_median_m, spacing_q75_m, spacing_q25_over_h, "
-                 "spacing_median_over_h, spacing_q75_over_h, depth_q25_m, depth_median_m, depth_q75_m, "
-                 "depth_q25_over_h, depth_median_over_h, depth_q75_over_h, window_min_x_m, window_max_x_m, "
-                 "particle_count, window_particle_count, damaged_particle_count, cluster_count, no_crevasse, "
-                 "fragmented, has_spacing, empty_window, empty_snapshot, spacings_json, settings_json) "
-                 "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+    Statement is(
+        db_,
+        "INSERT INTO summaries (case_id, measurement_time_s, crevasse_count, spacing_count, "
+        "dropped_spacing_count, spacing_q25_m, spacing_median_m, spacing_q75_m, "
+        "spacing_q25_over_h, "
+        "spacing_median_over_h, spacing_q75_over_h, depth_q25_m, depth_median_m, depth_q75_m, "
+        "depth_q25_over_h, depth_median_over_h, depth_q75_over_h, window_min_x_m, window_max_x_m, "
+        "particle_count, window_particle_count, damaged_particle_count, cluster_count, "
+        "no_crevasse, "
+        "fragmented, has_spacing, empty_window, empty_snapshot, spacings_json, settings_json) "
+        "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, "
+        "?, ?, ?)");
     int k = 0;
     auto add = [&](const auto& v) { is.bind(++k, v); };
     add(r.case_id);
@@ -470,10 +519,11 @@ void Store::record_result(const CaseResult& r) {
       for (int w = 0; w < 3; ++w) add(q(*s, w));
     add(m.settings.window_min_x_m);
     add(m.settings.window_max_x_m);
-    for (std::size_t n : {m.particle_count, m.window_particle_count, m.damaged_particle_count, m.cluster_count})
+    for (std::size_t n :
+         {m.particle_count, m.window_particle_count, m.damaged_particle_count, m.cluster_count})
       add(static_cast<std::int64_t>(n));
-    for (bool b : {m.flags.no_crevasse, m.flags.fragmented, m.flags.has_spacing, m.flags.empty_window,
-                   m.flags.empty_snapshot})
+    for (bool b : {m.flags.no_crevasse, m.flags.fragmented, m.flags.has_spacing,
+                   m.flags.empty_window, m.flags.empty_snapshot})
       add(static_cast<int>(b));
     add(nlohmann::json(m.spacings_m).dump());
     add(analysis::settings_to_json(m.settings).dump());
@@ -496,10 +546,14 @@ StatusCounts Store::counts() {
   while (s.step()) {
     const std::string st = s.text(0);
     const std::int64_t n = s.integer(1);
-    if (st == "pending") c.pending = n;
-    else if (st == "running") c.running = n;
-    else if (st == "done") c.done = n;
-    else if (st == "failed") c.failed = n;
+    if (st == "pending")
+      c.pending = n;
+    else if (st == "running")
+      c.running = n;
+    else if (st == "done")
+      c.done = n;
+    else if (st == "failed")
+      c.failed = n;
   }
   return c;
 }

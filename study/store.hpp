@@ -70,7 +70,7 @@ struct CaseResult {
   double wall_s = 0.0;
   std::optional<std::int64_t> peak_rss_bytes;
   int threads = 1;
-  std::string started_at;   // ISO 8601 UTC
+  std::string started_at;  // ISO 8601 UTC
   std::string finished_at;
   std::string session_id;
   nlohmann::json run_json = nlohmann::json::object();     // masses, stage timings, particle counts
@@ -128,13 +128,14 @@ class Store {
   // the same study (same case hashes), else throws InputError.
   void init_study(const Study& study);
   void begin_session(const SessionInfo& session);
-  void end_session(const std::string& session_id, const std::string& outcome, std::int64_t cases_run);
+  void end_session(const std::string& session_id, const std::string& outcome,
+                   std::int64_t cases_run);
   // Adds the cases not yet present as 'pending'. Cases present keep their state.
   void add_cases(const std::vector<const StudyCase*>& cases);
   // 'running' rows left by a killed run become 'pending' again; returns how many.
   std::int64_t reset_running();
-  void mark_running(const std::string& case_id, const std::string& session_id, const std::string& started_at,
-                    int threads);
+  void mark_running(const std::string& case_id, const std::string& session_id,
+                    const std::string& started_at, int threads);
   void mark_pending(const std::string& case_id);
   // Stores a finished case (row update, crevasses, summary) in one transaction.
   void record_result(const CaseResult& result);

@@ -27,10 +27,12 @@ class ConsoleObserver : public StudyObserver {
     printer_.finish();
     std::fprintf(stderr, "study %s: %zu case(s)", name_.c_str(), plan.in_scope);
     if (plan.already_done + plan.already_failed > 0)
-      std::fprintf(stderr, " (%zu stored as done, %zu as failed)", plan.already_done, plan.already_failed);
-    if (plan.interrupted > 0) std::fprintf(stderr, ", %zu interrupted by a killed run", plan.interrupted);
-    std::fprintf(stderr, "; running %zu on %d job(s) x %d engine thread(s) -> %s\n", p.pending, plan.jobs,
-                 plan.threads_per_case, db_.c_str());
+      std::fprintf(stderr, " (%zu stored as done, %zu as failed)", plan.already_done,
+                   plan.already_failed);
+    if (plan.interrupted > 0)
+      std::fprintf(stderr, ", %zu interrupted by a killed run", plan.interrupted);
+    std::fprintf(stderr, "; running %zu on %d job(s) x %d engine thread(s) -> %s\n", p.pending,
+                 plan.jobs, plan.threads_per_case, db_.c_str());
   }
 
   void on_case_finished(const StudyCase& c, const CaseResult& r, const RunnerProgress& p) override {
@@ -40,32 +42,38 @@ class ConsoleObserver : public StudyObserver {
       const auto& m = *r.measurement;
       char stats[160] = "no crevasse";
       if (!m.crevasses.empty())
-        std::snprintf(stats, sizeof stats, "%zu crevasse(s), median spacing %s H_i, median depth %s H_i",
-                      m.crevasses.size(), m.spacing_over_h ? fmt(m.spacing_over_h->median).c_str() : "-",
-                      m.depth_over_h ? fmt(m.depth_over_h->median).c_str() : "-");
-      std::fprintf(stderr, "[%zu/%zu] done   %s: %s%s (%s)\n", finished, p.total, c.label.c_str(), stats,
-                   m.flags.fragmented ? ", fragmented" : "", case_wall(r.wall_s).c_str());
+        std::snprintf(
+            stats, sizeof stats, "%zu crevasse(s), median spacing %s H_i, median depth %s H_i",
+            m.crevasses.size(), m.spacing_over_h ? fmt(m.spacing_over_h->median).c_str() : "-",
+            m.depth_over_h ? fmt(m.depth_over_h->median).c_str() : "-");
+      std::fprintf(stderr, "[%zu/%zu] done   %s: %s%s (%s)\n", finished, p.total, c.label.c_str(),
+                   stats, m.flags.fragmented ? ", fragmented" : "", case_wall(r.wall_s).c_str());
     } else if (r.status == "done") {
       std::fprintf(stderr, "[%zu/%zu] done   %s (%s)\n", finished, p.total, c.label.c_str(),
                    case_wall(r.wall_s).c_str());
     } else {
-      std::fprintf(stderr, "[%zu/%zu] FAILED %s: %s\n", finished, p.total, c.label.c_str(), r.failure_reason.c_str());
+      std::fprintf(stderr, "[%zu/%zu] FAILED %s: %s\n", finished, p.total, c.label.c_str(),
+                   r.failure_reason.c_str());
     }
   }
 
   void on_progress(const RunnerProgress& p) override {
     char line[256];
-    std::snprintf(line, sizeof line, "%s: done %zu/%zu  failed %zu  running %zu  pending %zu  elapsed %s  ETA %s",
-                  name_.c_str(), p.done, p.total, p.failed, p.running, p.pending, format_duration(p.elapsed_s).c_str(),
+    std::snprintf(line, sizeof line,
+                  "%s: done %zu/%zu  failed %zu  running %zu  pending %zu  elapsed %s  ETA %s",
+                  name_.c_str(), p.done, p.total, p.failed, p.running, p.pending,
+                  format_duration(p.elapsed_s).c_str(),
                   p.eta_s ? format_duration(*p.eta_s).c_str() : "?");
     if (!printer_is_tty_throttled(p)) printer_.update(line);
   }
 
   void on_end(const RunnerReport& r) override {
     printer_.finish();
-    std::fprintf(stderr, "study %s: ran %zu case(s) in %s: %zu done, %zu failed%s; see: crevasse status %s\n",
-                 name_.c_str(), r.ran, format_duration(r.wall_s).c_str(), r.done, r.failed,
-                 r.stopped ? " (stopped by --fail-fast)" : "", db_.c_str());
+    std::fprintf(
+        stderr,
+        "study %s: ran %zu case(s) in %s: %zu done, %zu failed%s; see: crevasse status %s\n",
+        name_.c_str(), r.ran, format_duration(r.wall_s).c_str(), r.done, r.failed,
+        r.stopped ? " (stopped by --fail-fast)" : "", db_.c_str());
   }
 
  private:
@@ -95,22 +103,26 @@ int study_command(const StudyCommandOptions& opt) {
 
   if (opt.dry_run) {
     const auto cases = shard ? shard_cases(study, *shard) : shard_cases(study, Shard{0, 1});
-    std::printf("study %s: %zu case(s)%s, study hash %s\n", study.name.c_str(), cases.size(),
-                shard ? (" in shard " + shard->text() + " of " + std::to_string(study.cases.size())).c_str() : "",
-                study.study_hash.substr(0, 16).c_str());
-    std::printf("%5s  %-16s %8s %8s %8s %8s %6s  %s\n", "index", "case", "H_i[m]", "Pi", "c[kPa]", "L_s[m]", "dx[m]",
-                "label");
+    std::printf(
+        "study %s: %zu case(s)%s, study hash %s\n", study.name.c_str(), cases.size(),
+        shard ? (" in shard " + shard->text() + " of " + std::to_string(study.cases.size())).c_str()
+              : "",
+        study.study_hash.substr(0, 16).c_str());
+    std::printf("%5s  %-16s %8s %8s %8s %8s %6s  %s\n", "index", "case", "H_i[m]", "Pi", "c[kPa]",
+                "L_s[m]", "dx[m]", "label");
     for (const StudyCase* c : cases)
-      std::printf("%5zu  %-16s %8.0f %8.4g %8.4g %8.4g %6.3g  %s\n", c->index, c->case_id.substr(0, 16).c_str(),
-                  c->groups.thickness_m, c->groups.cohesion_ratio, c->scene.tensile_strength / 1e3,
-                  c->scene.step_length, c->scene.dx, c->label.c_str());
+      std::printf("%5zu  %-16s %8.0f %8.4g %8.4g %8.4g %6.3g  %s\n", c->index,
+                  c->case_id.substr(0, 16).c_str(), c->groups.thickness_m, c->groups.cohesion_ratio,
+                  c->scene.tensile_strength / 1e3, c->scene.step_length, c->scene.dx,
+                  c->label.c_str());
     return 0;
   }
 
   std::string db = opt.db_path;
   if (db.empty()) {
     db = "results/" + study.name;
-    if (shard) db += ".shard-" + std::to_string(shard->index) + "-of-" + std::to_string(shard->count);
+    if (shard)
+      db += ".shard-" + std::to_string(shard->index) + "-of-" + std::to_string(shard->count);
     db += ".db";
   }
   ConsoleObserver console(study.name, db);
@@ -127,11 +139,13 @@ int study_command(const StudyCommandOptions& opt) {
   const RunnerReport r = run_study(study, ro);
   const std::size_t failed = r.failed + r.already_failed;
   if (r.stopped) {
-    std::fprintf(stderr, "crevasse: stopped at the first failure (--fail-fast): %s\n", r.first_failure.c_str());
+    std::fprintf(stderr, "crevasse: stopped at the first failure (--fail-fast): %s\n",
+                 r.first_failure.c_str());
     return 1;
   }
   if (failed > 0) {
-    std::fprintf(stderr, "crevasse: %zu of %zu case(s) failed; see crevasse status %s\n", failed, r.in_scope, db.c_str());
+    std::fprintf(stderr, "crevasse: %zu of %zu case(s) failed; see crevasse status %s\n", failed,
+                 r.in_scope, db.c_str());
     return 1;
   }
   return 0;

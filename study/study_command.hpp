@@ -7,14 +7,14 @@ namespace crevasse {
 
 struct StudyCommandOptions {
   std::string study_path;
-  std::string db_path;       // "" → results/<name>.db (results/<name>.shard-I-of-N.db with --shard)
-  int jobs = 0;              // 0 → resources.jobs, else cores / threads per case
-  int threads_per_case = 0;  // 0 → resources.threads_per_case, else 1
+  std::string db_path;  // "" → results/<name>.db (results/<name>.shard-I-of-N.db with --shard)
+  int jobs = 0;         // 0 → resources.jobs, else cores / threads per case
+  int threads_per_case = 0;         // 0 → resources.threads_per_case, else 1
   double case_time_limit_s = -1.0;  // < 0 → resources.case_time_limit_s
-  std::string shard;         // "I/N" or ""
+  std::string shard;                // "I/N" or ""
   bool fail_fast = false;
   bool retry_failed = false;
-  bool dry_run = false;      // list the cases and their hashes; run nothing, create nothing
+  bool dry_run = false;  // list the cases and their hashes; run nothing, create nothing
   bool quiet = false;
   std::string command_line;  // recorded in the sessions table
 };

@@ -172,14 +172,16 @@ std::string read_text(const std::filesystem::path& path, const std::string& fiel
 }
 
 // Every key of `obj` must be one of `allowed`.
-void refuse_unknown(const ordered_json& obj, const std::string& where, std::initializer_list<const char*> allowed) {
+void refuse_unknown(const ordered_json& obj, const std::string& where,
+                    std::initializer_list<const char*> allowed) {
   for (auto it = obj.begin(); it != obj.end(); ++it) {
     bool ok = false;
     for (const char* a : allowed) ok = ok || it.key() == a;
     if (!ok) {
       std::string list;
       for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
-      fail(where.empty() ? it.key() : where + "." + it.key(), "unknown key (allowed: " + list + ")");
+      fail(where.empty() ? it.key() : where + "." + it.key(),
+           "unknown key (allowed: " + list + ")");
     }
   }
 }
@@ -188,8 +190,8 @@ int integer_in(const ordered_json& v, const std::string& field, int lo, int hi) 
   if (!v.is_number_integer()) fail(field, "must be an integer, got " + v.dump());
   const auto x = v.get<std::int64_t>();
   if (x < lo || x > hi)
-    fail(field, "value " + std::to_string(x) + " is outside the allowed range [" + std::to_string(lo) + ", " +
-                    std::to_string(hi) + "]");
+    fail(field, "value " + std::to_string(x) + " is outside the allowed range [" +
+                    std::to_string(lo) + ", " + std::to_string(hi) + "]");
   return static_cast<int>(x);
 }
 
@@ -221,7 +223,8 @@ std::vector<json> expand_axis(const json& spec, const std::string& field) {
     return std::vector<json>(spec.begin(), spec.end());
   }
   if (!spec.is_object() || spec.size() != 1 || !(spec.contains("linear") || spec.contains("log")))
-    fail(field, "must be a list of values, {\"linear\": [a, b, n]} or {\"log\": [a, b, n]}, got " + spec.dump());
+    fail(field, "must be a list of values, {\"linear\": [a, b, n]} or {\"log\": [a, b, n]}, got " +
+                    spec.dump());
   const bool log = spec.contains("log");
   const std::string kind = log ? "log" : "linear";
   const json& r = spec.at(kind);
@@ -236,7 +239,8 @@ std::vector<json> expand_axis(const json& spec, const std::string& field) {
     fail(f, "count " + std::to_string(n) + " is outside the allowed range [1, 10000]");
   if (n == 1 && a != b) fail(f, "count 1 needs first == last (" + fmt(a) + " ≠ " + fmt(b) + ")");
   if (log && (a <= 0 || b <= 0))
-    fail(f, "bound " + fmt(a <= 0 ? a : b) + " is not allowed: log ranges need both bounds in (0, inf)");
+    fail(f, "bound " + fmt(a <= 0 ? a : b) +
+                " is not allowed: log ranges need both bounds in (0, inf)");
   std::vector<json> out;
   for (std::int64_t i = 0; i < n; ++i) {
     const double t = n == 1 ? 0.0 : static_cast<double>(i) / static_cast<double>(n - 1);
@@ -256,32 +260,36 @@ analysis::MeasureSettings measure_settings_from_json(const json& j) {
   refuse_unknown(o, "measurement",
                  {"damage_threshold", "eps_v_p_threshold", "window_min_x_m", "window_max_x_m",
                   "window_margin_over_h", "resolution_floor_over_dx", "link_distance_over_spacing",
-                  "surface_reach_over_dx", "surface_smoothing_bins", "surface_bridge_half_width_over_h",
-                  "fragmented_fraction", "y_band_width_over_dx", "y_band_center_m", "dx_m",
-                  "ice_thickness_m", "particle_spacing_m"});
+                  "surface_reach_over_dx", "surface_smoothing_bins",
+                  "surface_bridge_half_width_over_h", "fragmented_fraction", "y_band_width_over_dx",
+                  "y_band_center_m", "dx_m", "ice_thickness_m", "particle_spacing_m"});
   auto num = [&](const char* key, double& out, const Range& r) {
     if (o.contains(key)) out = number_in(o.at(key), std::string("measurement.") + key, r);
   };
   auto opt = [&](const char* key, std::optional<double>& out, const Range& r) {
-    if (o.contains(key) && !o.at(key).is_null()) out = number_in(o.at(key), std::string("measurement.") + key, r);
+    if (o.contains(key) && !o.at(key).is_null())
+      out = number_in(o.at(key), std::string("measurement.") + key, r);
   };
   num("damage_threshold", s.damage_threshold, {0.0, 1.0, true, true});
   num("eps_v_p_threshold", s.eps_v_p_threshold, {0.0, 10.0, true, false});
   opt("window_min_x_m", s.window_min_x_m, {-1e9, 1e9, false, false});
   opt("window_max_x_m", s.window_max_x_m, {-1e9, 1e9, false, false});
   if (s.window_min_x_m && s.window_max_x_m && *s.window_max_x_m <= *s.window_min_x_m)
-    fail("measurement.window_max_x_m", "value " + fmt(*s.window_max_x_m) + " must exceed window_min_x_m " +
-                                           fmt(*s.window_min_x_m));
+    fail("measurement.window_max_x_m", "value " + fmt(*s.window_max_x_m) +
+                                           " must exceed window_min_x_m " + fmt(*s.window_min_x_m));
   num("window_margin_over_h", s.window_margin_over_h, {0.0, 100.0, false, false});
   num("resolution_floor_over_dx", s.resolution_floor_over_dx, {0.0, 100.0, false, false});
   num("link_distance_over_spacing", s.link_distance_over_spacing, {0.0, 10.0, true, false});
   num("surface_reach_over_dx", s.surface_reach_over_dx, {0.0, 100.0, true, false});
   if (o.contains("surface_smoothing_bins")) {
-    s.surface_smoothing_bins = integer_in(o.at("surface_smoothing_bins"), "measurement.surface_smoothing_bins", 1, 101);
+    s.surface_smoothing_bins =
+        integer_in(o.at("surface_smoothing_bins"), "measurement.surface_smoothing_bins", 1, 101);
     if (s.surface_smoothing_bins % 2 == 0)
-      fail("measurement.surface_smoothing_bins", "value " + std::to_string(s.surface_smoothing_bins) + " must be odd");
+      fail("measurement.surface_smoothing_bins",
+           "value " + std::to_string(s.surface_smoothing_bins) + " must be odd");
   }
-  num("surface_bridge_half_width_over_h", s.surface_bridge_half_width_over_h, {0.0, 10.0, false, false});
+  num("surface_bridge_half_width_over_h", s.surface_bridge_half_width_over_h,
+      {0.0, 10.0, false, false});
   num("fragmented_fraction", s.fragmented_fraction, {0.0, 1.0, true, false});
   num("y_band_width_over_dx", s.y_band_width_over_dx, {0.0, 1e4, true, false});
   opt("y_band_center_m", s.y_band_center_m, {-1e9, 1e9, false, false});
@@ -313,7 +321,8 @@ json measure_settings_to_json(const analysis::MeasureSettings& s) {
   };
 }
 
-Study parse_study(const std::string& text, const std::filesystem::path& base_dir, const std::string& source) {
+Study parse_study(const std::string& text, const std::filesystem::path& base_dir,
+                  const std::string& source) {
   Study st;
   st.source_text = text;
   ordered_json doc;
@@ -323,14 +332,17 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
     throw InputError(source + ": not valid JSON (" + e.what() + ")");
   }
   if (!doc.is_object()) fail(source, "a study file must be a JSON object");
-  refuse_unknown(doc, "", {"name", "description", "base_scene", "fixed", "sweep", "replicas", "measurement",
-                           "resources"});
+  refuse_unknown(doc, "",
+                 {"name", "description", "base_scene", "fixed", "sweep", "replicas", "measurement",
+                  "resources"});
 
-  if (!doc.contains("name") || !doc.at("name").is_string()) fail("name", "required: a string naming the study");
+  if (!doc.contains("name") || !doc.at("name").is_string())
+    fail("name", "required: a string naming the study");
   st.name = doc.at("name").get<std::string>();
   if (st.name.empty() || st.name.size() > 64 ||
-      !std::all_of(st.name.begin(), st.name.end(),
-                   [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.'; }))
+      !std::all_of(st.name.begin(), st.name.end(), [](char c) {
+        return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.';
+      }))
     fail("name", "'" + st.name + "' must be 1 to 64 characters from A-Z a-z 0-9 _ - .");
   if (doc.contains("description")) {
     if (!doc.at("description").is_string()) fail("description", "must be a string");
@@ -338,7 +350,8 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
   }
 
   // Base scene: a path (relative to the study file) or an inline object.
-  if (!doc.contains("base_scene")) fail("base_scene", "required: a scene file path or an inline scene object");
+  if (!doc.contains("base_scene"))
+    fail("base_scene", "required: a scene file path or an inline scene object");
   const ordered_json& base = doc.at("base_scene");
   if (base.is_string()) {
     std::filesystem::path p = base.get<std::string>();
@@ -388,15 +401,18 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
       refuse_unknown(r, "replicas", {"count", "first_seed"});
       if (r.contains("count")) st.replicas = integer_in(r.at("count"), "replicas.count", 1, 1000);
       if (r.contains("first_seed"))
-        st.first_seed = static_cast<std::uint64_t>(integer_in(r.at("first_seed"), "replicas.first_seed", 0, 1000000000));
+        st.first_seed = static_cast<std::uint64_t>(
+            integer_in(r.at("first_seed"), "replicas.first_seed", 0, 1000000000));
     } else {
       st.replicas = integer_in(r, "replicas", 1, 1000);
     }
     if (st.replicas > 1 && seen.count("/numerics/seed"))
-      fail("replicas", "set /numerics/seed per replica; remove /numerics/seed from fixed and sweep");
+      fail("replicas",
+           "set /numerics/seed per replica; remove /numerics/seed from fixed and sweep");
   }
 
-  st.measurement = measure_settings_from_json(doc.contains("measurement") ? json(doc.at("measurement")) : json());
+  st.measurement = measure_settings_from_json(
+      doc.contains("measurement") ? json(doc.at("measurement")) : json());
   st.measurement_json = measure_settings_to_json(st.measurement);
 
   if (doc.contains("resources")) {
@@ -405,9 +421,11 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
     refuse_unknown(r, "resources", {"jobs", "threads_per_case", "case_time_limit_s"});
     if (r.contains("jobs")) st.resources.jobs = integer_in(r.at("jobs"), "resources.jobs", 0, 1024);
     if (r.contains("threads_per_case"))
-      st.resources.threads_per_case = integer_in(r.at("threads_per_case"), "resources.threads_per_case", 0, 1024);
+      st.resources.threads_per_case =
+          integer_in(r.at("threads_per_case"), "resources.threads_per_case", 0, 1024);
     if (r.contains("case_time_limit_s"))
-      st.resources.case_time_limit_s = number_in(r.at("case_time_limit_s"), "resources.case_time_limit_s", {0.0, 1e8, false, false});
+      st.resources.case_time_limit_s = number_in(
+          r.at("case_time_limit_s"), "resources.case_time_limit_s", {0.0, 1e8, false, false});
   }
 
   // Enumerate: Cartesian product, last axis fastest, replicas innermost.
@@ -415,7 +433,8 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
   for (const auto& a : st.axes) {
     total *= a.values.size();
     if (total > kMaxCases)
-      fail("sweep", "more than " + std::to_string(kMaxCases) + " cases; split the study into smaller ones");
+      fail("sweep",
+           "more than " + std::to_string(kMaxCases) + " cases; split the study into smaller ones");
   }
   const SceneConfig defaults;
   std::map<std::string, std::size_t> by_id;
@@ -432,8 +451,10 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
     json scene = st.base_scene;
     std::map<std::string, double> named;
     auto apply = [&](const std::string& name, const json& v) {
-      if (is_pointer(name)) scene[json::json_pointer(name)] = v;
-      else named[name] = v.get<double>();
+      if (is_pointer(name))
+        scene[json::json_pointer(name)] = v;
+      else
+        named[name] = v.get<double>();
     };
     for (const auto& [name, v] : st.fixed) apply(name, v);
     c.axes = json::object();
@@ -460,26 +481,33 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
     if (has("cohesion_ratio")) {
       const double rho = number_at(scene, "/ice/density", defaults.density);
       const double g = number_at(scene, "/gravity/g", defaults.gravity);
-      if (!(g > 0)) fail(where, "cohesion_ratio needs gravity.g > 0 (Π = c / (ρ_i g H_i)), got g = " + fmt(g));
+      if (!(g > 0))
+        fail(where, "cohesion_ratio needs gravity.g > 0 (Π = c / (ρ_i g H_i)), got g = " + fmt(g));
       scene["ice"]["tensile_strength"] = named["cohesion_ratio"] * rho * g * h_i;
     }
     if (has("step_length_ratio")) scene["bed"]["step_length"] = named["step_length_ratio"] * h_i;
     if (has("slope")) {
       const double l_s = number_at(scene, "/bed/step_length", defaults.step_length);
       if (!(l_s > 0))
-        fail(where, "slope needs a step of non-zero length; this step is vertical (step_length 0), so give "
-                    "step_height_ratio instead");
+        fail(
+            where,
+            "slope needs a step of non-zero length; this step is vertical (step_length 0), so give "
+            "step_height_ratio instead");
       scene["bed"]["step_height"] = named["slope"] * l_s;
     }
     if (has("step_height_ratio")) scene["bed"]["step_height"] = named["step_height_ratio"] * h_i;
     if (has("width_ratio")) {
       const double dim = number_at(scene, "/dim", defaults.dim);
-      if (dim != 3) fail(where, "width_ratio applies to 3D scenes only; this case has dim " + fmt(dim));
+      if (dim != 3)
+        fail(where, "width_ratio applies to 3D scenes only; this case has dim " + fmt(dim));
       scene["ice"]["width"] = named["width_ratio"] * h_i;
     }
-    if (has("front_past_step_ratio")) scene["run"]["front_past_step"] = named["front_past_step_ratio"] * h_i;
-    if (has("upstream_length_ratio")) scene["ice"]["upstream_length"] = named["upstream_length_ratio"] * h_i;
-    if (has("downstream_length_ratio")) scene["bed"]["downstream_length"] = named["downstream_length_ratio"] * h_i;
+    if (has("front_past_step_ratio"))
+      scene["run"]["front_past_step"] = named["front_past_step_ratio"] * h_i;
+    if (has("upstream_length_ratio"))
+      scene["ice"]["upstream_length"] = named["upstream_length_ratio"] * h_i;
+    if (has("downstream_length_ratio"))
+      scene["bed"]["downstream_length"] = named["downstream_length_ratio"] * h_i;
 
     try {
       c.scene = scene_from_json(scene);
@@ -487,15 +515,17 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
       throw InputError(where + ": " + e.what());
     }
     if (st.replicas > 1 && c.scene.jitter <= 0)
-      fail("replicas", "replicas differ only by /numerics/seed, which has no effect while /numerics/jitter is 0; "
-                       "set /numerics/jitter in (0, 0.5]");
+      fail("replicas",
+           "replicas differ only by /numerics/seed, which has no effect while /numerics/jitter is "
+           "0; "
+           "set /numerics/jitter in (0, 0.5]");
     c.scene_json = scene_to_json(c.scene);
     c.groups = groups_of(c.scene);
     c.case_id = case_hash(c.scene, st.measurement_json);
     const auto [it, inserted] = by_id.emplace(c.case_id, index);
     if (!inserted)
-      fail("sweep", "cases " + std::to_string(it->second) + " (" + st.cases[it->second].label + ") and " +
-                        std::to_string(index) + " (" + c.label +
+      fail("sweep", "cases " + std::to_string(it->second) + " (" + st.cases[it->second].label +
+                        ") and " + std::to_string(index) + " (" + c.label +
                         ") resolve to the same parameters; remove the repeated value");
     st.cases.push_back(std::move(c));
   }

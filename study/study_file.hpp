@@ -55,30 +55,30 @@ struct CaseGroups {
 };
 
 struct StudyCase {
-  std::size_t index = 0;   // position in the enumeration (last axis fastest, replicas innermost)
-  std::string label;       // "cohesion_ratio=0.1 thickness=100 replica=1"
-  nlohmann::json axes;     // this case's value on every sweep axis (and "replica")
+  std::size_t index = 0;  // position in the enumeration (last axis fastest, replicas innermost)
+  std::string label;      // "cohesion_ratio=0.1 thickness=100 replica=1"
+  nlohmann::json axes;    // this case's value on every sweep axis (and "replica")
   int replica = 0;
-  SceneConfig scene;       // resolved; run.wall_time_limit comes from resources at run time
+  SceneConfig scene;          // resolved; run.wall_time_limit comes from resources at run time
   nlohmann::json scene_json;  // scene_to_json(scene): canonical, every default explicit
   CaseGroups groups;
-  std::string case_id;     // case_hash(): SHA-256 hex
+  std::string case_id;  // case_hash(): SHA-256 hex
 };
 
 struct Study {
   std::string name;
   std::string description;
-  std::string source_text;           // the file as given (stored in the database)
-  nlohmann::json base_scene;         // the base scene as written (before any override)
+  std::string source_text;    // the file as given (stored in the database)
+  nlohmann::json base_scene;  // the base scene as written (before any override)
   std::vector<std::pair<std::string, nlohmann::json>> fixed;
   std::vector<SweepAxis> axes;
   int replicas = 1;
   std::uint64_t first_seed = 1;
   analysis::MeasureSettings measurement;
-  nlohmann::json measurement_json;   // canonical form of `measurement` (enters the case hash)
+  nlohmann::json measurement_json;  // canonical form of `measurement` (enters the case hash)
   StudyResources resources;
   std::vector<StudyCase> cases;
-  std::string study_hash;            // SHA-256 of the sorted case ids: same cases ⇔ same study
+  std::string study_hash;  // SHA-256 of the sorted case ids: same cases ⇔ same study
 };
 
 // Reads and validates a study file; a relative base_scene path is taken from the file's

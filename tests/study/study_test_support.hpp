@@ -1,7 +1,9 @@
 #pragma once
 // Shared by the study tests: scratch directories, tiny real scenes, deterministic fake cases,
 // and database dumps for comparing two runs.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <spawn.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -15,6 +17,8 @@
 #include "study/store.hpp"
 #include "study/study_file.hpp"
 
+extern char** environ;
+
 namespace crevasse::test {
 
 // A fresh directory under the system temp dir, removed at the end of the test.
@@ -23,7 +27,8 @@ class ScratchDir {
   explicit ScratchDir(const std::string& tag) {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
     path_ = std::filesystem::temp_directory_path() /
-            ("crevasse_" + tag + "_" + (info ? std::string(info->name()) : "x") + "_" + std::to_string(::getpid()));
+            ("crevasse_" + tag + "_" + (info ? std::string(info->name()) : "x") + "_" +
+             std::to_string(::getpid()));
     std::filesystem::remove_all(path_);
     std::filesystem::create_directories(path_);
   }
@@ -56,7 +61,8 @@ inline nlohmann::json tiny_scene(std::int64_t max_steps = 200) {
 }
 
 // A study over cohesion_ratio with `n` values on the tiny scene.
-inline nlohmann::json tiny_study(int n, std::int64_t max_steps = 200, const std::string& name = "tiny") {
+inline nlohmann::json tiny_study(int n, std::int64_t max_steps = 200,
+                                 const std::string& name = "tiny") {
   return {{"name", name},
           {"base_scene", tiny_scene(max_steps)},
           {"fixed", {{"step_length_ratio", 1.0}, {"slope", 1.0}}},
@@ -64,7 +70,9 @@ inline nlohmann::json tiny_study(int n, std::int64_t max_steps = 200, const std:
           {"resources", {{"threads_per_case", 1}}}};
 }
 
-inline Study parse(const nlohmann::json& j) { return parse_study(j.dump(), std::filesystem::current_path(), "test"); }
+inline Study parse(const nlohmann::json& j) {
+  return parse_study(j.dump(), std::filesystem::current_path(), "test");
+}
 
 // A deterministic stand-in for the engine: index+1 crevasses 50 m apart, depth from Π.
 inline CaseOutcome fake_outcome(const StudyCase& c, double depth_scale = 1.0) {
@@ -114,9 +122,11 @@ inline std::vector<std::string> dump_rows(const std::filesystem::path& db, const
 inline std::vector<std::string> result_dump(const std::filesystem::path& db) {
   std::vector<std::string> all;
   for (const char* sql :
-       {"SELECT case_id, case_index, label, status, failure_reason IS NOT NULL, stop_reason, steps, particle_steps, "
+       {"SELECT case_id, case_index, label, status, failure_reason IS NOT NULL, stop_reason, "
+        "steps, particle_steps, "
         "sim_time_s, result_json, result_hash, scene_json FROM cases ORDER BY case_id",
-        "SELECT * FROM crevasses ORDER BY case_id, crevasse_index", "SELECT * FROM summaries ORDER BY case_id",
+        "SELECT * FROM crevasses ORDER BY case_id, crevasse_index",
+        "SELECT * FROM summaries ORDER BY case_id",
         "SELECT name, study_hash, case_count, file_text FROM study"}) {
     auto rows = dump_rows(db, sql);
     all.push_back(std::string("-- ") + sql);
@@ -128,6 +138,24 @@ inline std::vector<std::string> result_dump(const std::filesystem::path& db) {
 inline std::string pragma_integrity(const std::filesystem::path& db) {
   const auto rows = dump_rows(db, "PRAGMA integrity_check");
   return rows.empty() ? "" : rows.front();
+}
+
+// Starts the crevasse binary (CREVASSE_BINARY) with `args`, its stderr to `stderr_path`;
+// returns the child's pid, or -1.
+inline pid_t spawn_crevasse(const std::vector<std::string>& args, const std::string& stderr_path) {
+  std::vector<std::string> all = {CREVASSE_BINARY};
+  all.insert(all.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& a : all) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 2, stderr_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                   0644);
+  pid_t pid = -1;
+  const int rc = posix_spawn(&pid, CREVASSE_BINARY, &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  return rc == 0 ? pid : -1;
 }
 
 }  // namespace crevasse::test

@@ -2,10 +2,9 @@
 // any database exists; status, export --csv and the sqlite3 CLI read a study database; a study
 // killed with SIGKILL resumes with the same command, loses nothing, reruns nothing finished,
 // and ends with the same contents as an uninterrupted run.
-#include <gtest/gtest.h>
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <signal.h>
-#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -15,8 +14,6 @@
 #include <thread>
 
 #include "study_test_support.hpp"
-
-extern char** environ;
 
 namespace crevasse {
 namespace {
@@ -37,7 +34,8 @@ struct Result {
 
 // Runs the crevasse binary with `args` (already shell-quoted where needed) in `dir`.
 Result run_cli(const std::filesystem::path& dir, const std::string& args) {
-  const std::string cmd = "cd '" + dir.string() + "' && '" CREVASSE_BINARY "' " + args + " > cli_out.txt 2> cli_err.txt";
+  const std::string cmd = "cd '" + dir.string() + "' && '" CREVASSE_BINARY "' " + args +
+                          " > cli_out.txt 2> cli_err.txt";
   const int status = std::system(cmd.c_str());
   Result r;
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -49,7 +47,8 @@ Result run_cli(const std::filesystem::path& dir, const std::string& args) {
 TEST(Cli, InvalidStudyFilesExitWithCode2AndCreateNoDatabase) {
   test::ScratchDir dir("cli");
   const std::vector<std::pair<std::string, std::string>> bad = {
-      {R"({"name": "b", "base_scene": {}, "sweep": {"cohesion_ratio": {"log": [0, 1, 3]}}})", "sweep.cohesion_ratio.log"},
+      {R"({"name": "b", "base_scene": {}, "sweep": {"cohesion_ratio": {"log": [0, 1, 3]}}})",
+       "sweep.cohesion_ratio.log"},
       {R"({"name": "b", "base_scene": "missing.json"})", "base_scene: cannot open"},
       {R"({"name": "b"})", "base_scene: required"},
       {"not json", "not valid JSON"},
@@ -82,7 +81,8 @@ TEST(Cli, StudyStatusExportAndSqlite3) {
 
   const Result status = run_cli(dir.path(), "status results/cli.db");
   EXPECT_EQ(status.code, 0) << status.err;
-  EXPECT_NE(status.out.find("3 done, 0 failed, 0 running, 0 pending"), std::string::npos) << status.out;
+  EXPECT_NE(status.out.find("3 done, 0 failed, 0 running, 0 pending"), std::string::npos)
+      << status.out;
   EXPECT_NE(status.out.find("cohesion_ratio=0.05"), std::string::npos) << status.out;
 
   const Result exp = run_cli(dir.path(), "export results/cli.db --csv csv");
@@ -93,32 +93,18 @@ TEST(Cli, StudyStatusExportAndSqlite3) {
   }
   const std::string cases = read_file(dir / "csv" / "cases.csv");
   const std::string header = cases.substr(0, cases.find('\n'));
-  for (const char* col : {"case_id", "cohesion_ratio", "status", "axis.cohesion_ratio", "scene.ice.tensile_strength",
-                          "scene.numerics.dx"})
+  for (const char* col : {"case_id", "cohesion_ratio", "status", "axis.cohesion_ratio",
+                          "scene.ice.tensile_strength", "scene.numerics.dx"})
     EXPECT_NE(header.find(col), std::string::npos) << col;
   EXPECT_EQ(std::count(cases.begin(), cases.end(), '\n'), 4);
 
   if (std::system("command -v sqlite3 > /dev/null 2>&1") == 0) {
     const std::string cmd = "sqlite3 '" + (dir / "results" / "cli.db").string() +
-                            "' \"SELECT count(*) FROM cases WHERE status = 'done'\" > '" + (dir / "q.txt").string() + "'";
+                            "' \"SELECT count(*) FROM cases WHERE status = 'done'\" > '" +
+                            (dir / "q.txt").string() + "'";
     ASSERT_EQ(std::system(cmd.c_str()), 0);
     EXPECT_EQ(read_file(dir / "q.txt"), "3\n");
   }
-}
-
-pid_t spawn_cli(const std::filesystem::path& dir, const std::vector<std::string>& args) {
-  std::vector<std::string> all = {CREVASSE_BINARY};
-  all.insert(all.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (auto& a : all) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 2, (dir / "killed_err.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  pid_t pid = -1;
-  const int rc = posix_spawn(&pid, CREVASSE_BINARY, &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  return rc == 0 ? pid : -1;
 }
 
 std::int64_t done_count(const std::filesystem::path& db) {
@@ -133,14 +119,22 @@ TEST(Cli, SigkillDuringAStudyThenResumeLosesAndRerunsNothing) {
   test::ScratchDir dir("cli");
   constexpr int kCases = 8;
   test::write_text(dir / "s.json", test::tiny_study(kCases, 4500, "killed").dump(2));
-  const std::vector<std::string> args = {"study", (dir / "s.json").string(), "--db", (dir / "k.db").string(),
-                                         "--jobs", "2", "--threads-per-case", "1", "--quiet"};
+  const std::vector<std::string> args = {"study",
+                                         (dir / "s.json").string(),
+                                         "--db",
+                                         (dir / "k.db").string(),
+                                         "--jobs",
+                                         "2",
+                                         "--threads-per-case",
+                                         "1",
+                                         "--quiet"};
 
   // Reference: the same study, uninterrupted.
-  const Result ref = run_cli(dir.path(), "study s.json --db ref.db --jobs 2 --threads-per-case 1 --quiet");
+  const Result ref =
+      run_cli(dir.path(), "study s.json --db ref.db --jobs 2 --threads-per-case 1 --quiet");
   ASSERT_EQ(ref.code, 0) << ref.err;
 
-  const pid_t pid = spawn_cli(dir.path(), args);
+  const pid_t pid = test::spawn_crevasse(args, (dir / "killed_err.txt").string());
   ASSERT_GT(pid, 0);
   const auto deadline = std::chrono::steady_clock::now() + 60s;
   std::int64_t done_at_kill = 0;
@@ -152,23 +146,28 @@ TEST(Cli, SigkillDuringAStudyThenResumeLosesAndRerunsNothing) {
   ASSERT_EQ(::kill(pid, SIGKILL), 0);
   int status = 0;
   ::waitpid(pid, &status, 0);
-  ASSERT_TRUE(WIFSIGNALED(status)) << "the study ended before it could be killed; make its cases longer";
+  ASSERT_TRUE(WIFSIGNALED(status))
+      << "the study ended before it could be killed; make its cases longer";
   ASSERT_GE(done_at_kill, 2);
 
   // After the kill: a sound database holding whole cases only.
   EXPECT_EQ(test::pragma_integrity(dir / "k.db"), "ok");
-  const auto finished_sql = "SELECT case_id, status, finished_at, session_id, wall_s, attempts, result_hash FROM cases "
-                            "WHERE status = 'done' ORDER BY case_id";
+  const auto finished_sql =
+      "SELECT case_id, status, finished_at, session_id, wall_s, attempts, result_hash FROM cases "
+      "WHERE status = 'done' ORDER BY case_id";
   const auto before = test::dump_rows(dir / "k.db", finished_sql);
   ASSERT_GE(before.size(), 2u);
-  ASSERT_LT(before.size(), static_cast<std::size_t>(kCases)) << "all cases finished before the kill";
-  EXPECT_EQ(test::dump_rows(dir / "k.db", "SELECT count(*) FROM cases c WHERE status = 'done' AND NOT EXISTS "
-                                          "(SELECT 1 FROM summaries s WHERE s.case_id = c.case_id)")
+  ASSERT_LT(before.size(), static_cast<std::size_t>(kCases))
+      << "all cases finished before the kill";
+  EXPECT_EQ(test::dump_rows(dir / "k.db",
+                            "SELECT count(*) FROM cases c WHERE status = 'done' AND NOT EXISTS "
+                            "(SELECT 1 FROM summaries s WHERE s.case_id = c.case_id)")
                 .at(0),
             "0")
       << "a done case without its summary";
-  EXPECT_EQ(test::dump_rows(dir / "k.db", "SELECT count(*) FROM summaries s JOIN cases c USING (case_id) "
-                                          "WHERE c.status != 'done'")
+  EXPECT_EQ(test::dump_rows(dir / "k.db",
+                            "SELECT count(*) FROM summaries s JOIN cases c USING (case_id) "
+                            "WHERE c.status != 'done'")
                 .at(0),
             "0")
       << "results of an unfinished case";
@@ -181,10 +180,14 @@ TEST(Cli, SigkillDuringAStudyThenResumeLosesAndRerunsNothing) {
 
   // Nothing finished before the kill ran again: same finish time, session and attempt count.
   const auto after = test::dump_rows(dir / "k.db", finished_sql);
-  for (const auto& row : before) EXPECT_NE(std::find(after.begin(), after.end(), row), after.end()) << row;
+  for (const auto& row : before)
+    EXPECT_NE(std::find(after.begin(), after.end(), row), after.end()) << row;
   EXPECT_EQ(after.size(), static_cast<std::size_t>(kCases));
-  EXPECT_EQ(test::dump_rows(dir / "k.db", "SELECT count(DISTINCT session_id) FROM cases").at(0), "2");
-  EXPECT_EQ(test::dump_rows(dir / "k.db", "SELECT count(*) FROM sessions WHERE outcome IS NULL").at(0), "1")
+  EXPECT_EQ(test::dump_rows(dir / "k.db", "SELECT count(DISTINCT session_id) FROM cases").at(0),
+            "2");
+  EXPECT_EQ(
+      test::dump_rows(dir / "k.db", "SELECT count(*) FROM sessions WHERE outcome IS NULL").at(0),
+      "1")
       << "the killed session stays open in the record";
 
   // Same results as the uninterrupted run.

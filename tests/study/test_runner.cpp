@@ -38,13 +38,16 @@ TEST(Runner, AFailingMiddleCaseIsRecordedAndTheOthersComplete) {
   EXPECT_EQ(r.failed, 1u);
   EXPECT_FALSE(r.stopped);
   EXPECT_NE(r.first_failure.find("instability at step 17"), std::string::npos);
-  const auto rows = test::dump_rows(dir / "s.db", "SELECT case_index, status, coalesce(failure_reason, '') FROM cases "
-                                                  "ORDER BY case_index");
+  const auto rows =
+      test::dump_rows(dir / "s.db",
+                      "SELECT case_index, status, coalesce(failure_reason, '') FROM cases "
+                      "ORDER BY case_index");
   ASSERT_EQ(rows.size(), 5u);
   EXPECT_EQ(rows[2], "2|failed|instability at step 17, particle 4: |v| = inf");
   for (int i : {0, 1, 3, 4}) EXPECT_EQ(rows[i], std::to_string(i).append("|done|"));
   // Failed cases have no crevasse rows; the others have index+1 each.
-  EXPECT_EQ(test::dump_rows(dir / "s.db", "SELECT count(*) FROM crevasses").at(0), std::to_string(1 + 2 + 4 + 5));
+  EXPECT_EQ(test::dump_rows(dir / "s.db", "SELECT count(*) FROM crevasses").at(0),
+            std::to_string(1 + 2 + 4 + 5));
   EXPECT_EQ(test::pragma_integrity(dir / "s.db"), "ok");
 }
 
@@ -57,7 +60,8 @@ TEST(Runner, OtherExceptionsFailTheCaseWithTheirReason) {
     return test::fake_outcome(c);
   };
   run_study(study, fake_options(dir / "s.db", fn));
-  const auto rows = test::dump_rows(dir / "s.db", "SELECT failure_reason FROM cases ORDER BY case_index");
+  const auto rows =
+      test::dump_rows(dir / "s.db", "SELECT failure_reason FROM cases ORDER BY case_index");
   EXPECT_EQ(rows[0], "error: measurement went wrong");
   EXPECT_EQ(rows[1], "out of memory");
   EXPECT_EQ(rows[2], "NULL");
@@ -76,10 +80,12 @@ TEST(Runner, FailFastStopsAtTheFirstFailureAndLeavesTheRestPending) {
   EXPECT_TRUE(r.stopped);
   EXPECT_EQ(r.done, 1u);
   EXPECT_EQ(r.failed, 1u);
-  EXPECT_EQ(test::dump_rows(dir / "s.db", "SELECT group_concat(status, ',') FROM (SELECT status FROM cases ORDER BY "
-                                          "case_index)")
-                .at(0),
-            "done,failed,pending,pending,pending");
+  EXPECT_EQ(
+      test::dump_rows(dir / "s.db",
+                      "SELECT group_concat(status, ',') FROM (SELECT status FROM cases ORDER BY "
+                      "case_index)")
+          .at(0),
+      "done,failed,pending,pending,pending");
 }
 
 TEST(Runner, FailFastCancelsRunningCasesWhichStayPending) {
@@ -121,7 +127,8 @@ TEST(Runner, ACaseOverItsTimeLimitFails) {
   const RunnerReport r = run_study(study, o);
   EXPECT_EQ(r.failed, 1u);
   EXPECT_EQ(r.done, 2u);
-  const auto reason = test::dump_rows(dir / "s.db", "SELECT failure_reason FROM cases WHERE case_index = 1").at(0);
+  const auto reason =
+      test::dump_rows(dir / "s.db", "SELECT failure_reason FROM cases WHERE case_index = 1").at(0);
   EXPECT_NE(reason.find("time limit"), std::string::npos) << reason;
 }
 
@@ -162,14 +169,17 @@ TEST(Runner, FinishedCasesAreNeverRunAgain) {
   };
   run_study(study, fake_options(dir / "s.db", fn));
   EXPECT_EQ(calls.size(), 4u);
-  const auto before = test::dump_rows(dir / "s.db", "SELECT case_id, finished_at, session_id FROM cases ORDER BY case_id");
+  const auto before = test::dump_rows(
+      dir / "s.db", "SELECT case_id, finished_at, session_id FROM cases ORDER BY case_id");
 
   const RunnerReport again = run_study(study, fake_options(dir / "s.db", fn));
   EXPECT_EQ(calls.size(), 4u) << "a stored case ran again";
   EXPECT_EQ(again.already_done, 3u);
   EXPECT_EQ(again.already_failed, 1u);
   EXPECT_EQ(again.ran, 0u);
-  EXPECT_EQ(before, test::dump_rows(dir / "s.db", "SELECT case_id, finished_at, session_id FROM cases ORDER BY case_id"));
+  EXPECT_EQ(before,
+            test::dump_rows(dir / "s.db",
+                            "SELECT case_id, finished_at, session_id FROM cases ORDER BY case_id"));
 
   RunnerOptions retry = fake_options(dir / "s.db", fn);
   retry.retry_failed = true;
@@ -181,7 +191,9 @@ TEST(Runner, FinishedCasesAreNeverRunAgain) {
 
 class CountingObserver : public StudyObserver {
  public:
-  void on_start(const RunnerReport&, const RunnerProgress& p) override { start_pending = p.pending; }
+  void on_start(const RunnerReport&, const RunnerProgress& p) override {
+    start_pending = p.pending;
+  }
   void on_case_finished(const StudyCase&, const CaseResult&, const RunnerProgress& p) override {
     ++finished;
     last = p;
@@ -196,7 +208,8 @@ TEST(Runner, ReportsProgressToItsObserver) {
   test::ScratchDir dir("runner");
   const Study study = test::parse(test::tiny_study(4));
   CountingObserver obs;
-  RunnerOptions o = fake_options(dir / "s.db", [](const StudyCase& c, CaseContext&) { return test::fake_outcome(c); });
+  RunnerOptions o = fake_options(
+      dir / "s.db", [](const StudyCase& c, CaseContext&) { return test::fake_outcome(c); });
   o.observer = &obs;
   run_study(study, o);
   EXPECT_EQ(obs.start_pending, 4u);
@@ -217,9 +230,11 @@ TEST(Runner, RealTinySimulationsAreStoredWithTheirMeasurements) {
   o.threads_per_case = 1;
   const RunnerReport r = run_study(study, o);
   EXPECT_EQ(r.done, 3u) << r.first_failure;
-  const auto rows = test::dump_rows(dir / "s.db", "SELECT c.status, c.stop_reason, c.steps, c.threads, "
-                                                  "s.particle_count > 0, c.peak_rss_bytes > 0, c.particle_steps > 0 "
-                                                  "FROM cases c JOIN summaries s USING (case_id) ORDER BY case_index");
+  const auto rows =
+      test::dump_rows(dir / "s.db",
+                      "SELECT c.status, c.stop_reason, c.steps, c.threads, "
+                      "s.particle_count > 0, c.peak_rss_bytes > 0, c.particle_steps > 0 "
+                      "FROM cases c JOIN summaries s USING (case_id) ORDER BY case_index");
   ASSERT_EQ(rows.size(), 3u);
   for (const auto& row : rows) EXPECT_EQ(row, "done|max_steps|300|1|1|1|1");
   // Deterministic with one engine thread per case: a second database holds the same results.

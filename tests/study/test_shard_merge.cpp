@@ -22,8 +22,10 @@ TEST(Shard, SharesAreDisjointBalancedAndCoverTheStudy) {
       const auto share = shard_cases(study, Shard{i, n});
       smallest = std::min(smallest, share.size());
       largest = std::max(largest, share.size());
-      for (const StudyCase* c : share) EXPECT_TRUE(seen.insert(c->case_id).second) << "case in two shards";
-      for (std::size_t k = 1; k < share.size(); ++k) EXPECT_LT(share[k - 1]->index, share[k]->index);
+      for (const StudyCase* c : share)
+        EXPECT_TRUE(seen.insert(c->case_id).second) << "case in two shards";
+      for (std::size_t k = 1; k < share.size(); ++k)
+        EXPECT_LT(share[k - 1]->index, share[k]->index);
     }
     EXPECT_EQ(seen.size(), study.cases.size());
     EXPECT_LE(largest - smallest, 1u);
@@ -32,12 +34,15 @@ TEST(Shard, SharesAreDisjointBalancedAndCoverTheStudy) {
 
 TEST(Shard, DependsOnTheCasesNotOnTheFileLayout) {
   const std::string scene = test::tiny_scene().dump();
-  const Study a = parse_study(R"({"name": "a", "base_scene": )" + scene +
-                                  R"(, "sweep": {"cohesion_ratio": [0.1, 0.2, 0.3], "thickness": [40, 50]}})",
-                              ".", "a");
-  const Study b = parse_study(R"({"sweep": {"thickness": [40, 50], "cohesion_ratio": [0.1, 0.2, 0.3]}, "name": "a",
-                                  "base_scene": )" + scene + "}",
-                              ".", "b");
+  const Study a =
+      parse_study(R"({"name": "a", "base_scene": )" + scene +
+                      R"(, "sweep": {"cohesion_ratio": [0.1, 0.2, 0.3], "thickness": [40, 50]}})",
+                  ".", "a");
+  const Study b = parse_study(
+      R"({"sweep": {"thickness": [40, 50], "cohesion_ratio": [0.1, 0.2, 0.3]}, "name": "a",
+                                  "base_scene": )" +
+          scene + "}",
+      ".", "b");
   for (int i = 0; i < 3; ++i) {
     std::set<std::string> sa, sb;
     for (const StudyCase* c : shard_cases(a, Shard{i, 3})) sa.insert(c->case_id);
@@ -46,7 +51,8 @@ TEST(Shard, DependsOnTheCasesNotOnTheFileLayout) {
   }
 }
 
-RunnerOptions real_options(const std::filesystem::path& db, std::optional<Shard> shard = std::nullopt) {
+RunnerOptions real_options(const std::filesystem::path& db,
+                           std::optional<Shard> shard = std::nullopt) {
   RunnerOptions o;
   o.db_path = db;
   o.jobs = 2;
@@ -59,9 +65,11 @@ TEST(Merge, ShardsMergedEqualOneRun) {
   test::ScratchDir dir("merge");
   const Study study = test::parse(test::tiny_study(5, 200));
   run_study(study, real_options(dir / "single.db"));
-  for (int i = 0; i < 3; ++i) run_study(study, real_options(dir / ("shard" + std::to_string(i) + ".db"), Shard{i, 3}));
+  for (int i = 0; i < 3; ++i)
+    run_study(study, real_options(dir / ("shard" + std::to_string(i) + ".db"), Shard{i, 3}));
   EXPECT_EQ(Store::open_reader(dir / "shard1.db").counts().total(), 2);
-  const MergeReport r = merge_databases(dir / "merged.db", {dir / "shard0.db", dir / "shard1.db", dir / "shard2.db"});
+  const MergeReport r =
+      merge_databases(dir / "merged.db", {dir / "shard0.db", dir / "shard1.db", dir / "shard2.db"});
   EXPECT_EQ(r.inputs, 3u);
   EXPECT_EQ(r.copied, 5u);
   EXPECT_EQ(r.conflicts, 0u);
@@ -70,7 +78,8 @@ TEST(Merge, ShardsMergedEqualOneRun) {
   EXPECT_EQ(test::pragma_integrity(dir / "merged.db"), "ok");
 
   // Merging again changes nothing: identical cases are kept once.
-  const MergeReport again = merge_databases(dir / "merged.db", {dir / "shard0.db", dir / "single.db"});
+  const MergeReport again =
+      merge_databases(dir / "merged.db", {dir / "shard0.db", dir / "single.db"});
   EXPECT_EQ(again.copied, 0u);
   EXPECT_EQ(again.identical, 2u + 5u);
   EXPECT_EQ(test::result_dump(dir / "merged.db"), test::result_dump(dir / "single.db"));
@@ -95,10 +104,16 @@ TEST(Merge, AFinishedCaseReplacesAPendingOneAndConflictsAreReported) {
   EXPECT_EQ(r.copied, 4u);
   EXPECT_EQ(r.conflicts, 4u);
   ASSERT_EQ(r.conflict_lines.size(), 4u);
-  for (const auto& line : r.conflict_lines) EXPECT_NE(line.find("kept out.db's"), std::string::npos) << line;
+  for (const auto& line : r.conflict_lines)
+    EXPECT_NE(line.find("kept out.db's"), std::string::npos) << line;
   // out.db keeps a.db's results.
-  EXPECT_EQ(test::dump_rows(dir / "out.db", "SELECT group_concat(result_hash) FROM (SELECT result_hash FROM cases ORDER BY case_id)"),
-            test::dump_rows(dir / "a.db", "SELECT group_concat(result_hash) FROM (SELECT result_hash FROM cases ORDER BY case_id)"));
+  EXPECT_EQ(
+      test::dump_rows(
+          dir / "out.db",
+          "SELECT group_concat(result_hash) FROM (SELECT result_hash FROM cases ORDER BY case_id)"),
+      test::dump_rows(dir / "a.db",
+                      "SELECT group_concat(result_hash) FROM (SELECT result_hash FROM cases ORDER "
+                      "BY case_id)"));
 }
 
 TEST(Merge, RefusesAnotherStudyAndTheOutputAsInput) {
@@ -114,7 +129,8 @@ TEST(Merge, RefusesAnotherStudyAndTheOutputAsInput) {
     merge_databases(dir / "out.db", {dir / "a.db", dir / "b.db"});
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("merge only databases of one study"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("merge only databases of one study"), std::string::npos)
+        << e.what();
   }
   EXPECT_THROW(merge_databases(dir / "a.db", {dir / "a.db"}), InputError);
   EXPECT_THROW(merge_databases(dir / "c.db", {dir / "missing.db"}), InputError);

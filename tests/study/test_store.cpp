@@ -24,8 +24,10 @@ TEST(Store, CreatesTheSchemaInWalMode) {
     ASSERT_TRUE(s.step());
     EXPECT_EQ(s.text(0), "wal");
   }
-  const auto tables = test::dump_rows(db, "SELECT name FROM sqlite_master WHERE type = 'table' ORDER BY name");
-  EXPECT_EQ(tables, (std::vector<std::string>{"cases", "crevasses", "sessions", "study", "summaries"}));
+  const auto tables =
+      test::dump_rows(db, "SELECT name FROM sqlite_master WHERE type = 'table' ORDER BY name");
+  EXPECT_EQ(tables,
+            (std::vector<std::string>{"cases", "crevasses", "sessions", "study", "summaries"}));
   EXPECT_EQ(test::dump_rows(db, "PRAGMA user_version").at(0), std::to_string(kStoreSchemaVersion));
 }
 
@@ -36,7 +38,8 @@ TEST(Store, OnlyOneWriterAtATime) {
     Store second = Store::open_writer(dir / "s.db");
     FAIL() << "a second writer was allowed";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("another crevasse process is writing"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("another crevasse process is writing"), std::string::npos)
+        << e.what();
   }
   // Readers are always welcome.
   Store reader = Store::open_reader(dir / "s.db");
@@ -46,7 +49,8 @@ TEST(Store, OnlyOneWriterAtATime) {
 TEST(Store, RefusesOtherFilesAndOtherStudies) {
   test::ScratchDir dir("store");
   EXPECT_THROW(Store::open_reader(dir / "missing.db"), InputError);
-  test::write_text(dir / "text.db", "this is not a database, just some text that is long enough to matter....");
+  test::write_text(dir / "text.db",
+                   "this is not a database, just some text that is long enough to matter....");
   EXPECT_THROW(Store::open_reader(dir / "text.db"), InputError);
   {
     sqlite3* other = nullptr;
@@ -89,8 +93,12 @@ TEST(Store, AFinishedCaseIsStoredWhole) {
   store.record_result(r);
   EXPECT_EQ(store.counts().done, 1);
   EXPECT_EQ(test::dump_rows(dir / "s.db", "SELECT count(*) FROM crevasses").at(0), "3");
-  EXPECT_EQ(test::dump_rows(dir / "s.db", "SELECT crevasse_count, spacing_median_m FROM summaries").at(0), "3|50.0");
-  EXPECT_EQ(test::dump_rows(dir / "s.db", "SELECT attempts, status FROM cases WHERE case_id = '" + c.case_id + "'").at(0),
+  EXPECT_EQ(
+      test::dump_rows(dir / "s.db", "SELECT crevasse_count, spacing_median_m FROM summaries").at(0),
+      "3|50.0");
+  EXPECT_EQ(test::dump_rows(dir / "s.db", "SELECT attempts, status FROM cases WHERE case_id = '" +
+                                              c.case_id + "'")
+                .at(0),
             "1|done");
 
   // Stored again (a retried case): replaced, not duplicated.

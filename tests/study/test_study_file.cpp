@@ -17,9 +17,7 @@ using nlohmann::json;
 using test::parse;
 using test::tiny_scene;
 
-json base_study() {
-  return {{"name", "t"}, {"base_scene", tiny_scene()}};
-}
+json base_study() { return {{"name", "t"}, {"base_scene", tiny_scene()}}; }
 
 TEST(StudyFile, LinearAndLogAxesIncludeBothEndsAndRoundCleanly) {
   const auto lin = expand_axis(json{{"linear", {0.0, 1.0, 5}}}, "x");
@@ -45,8 +43,9 @@ TEST(StudyFile, CartesianProductLastAxisFastestReplicasInnermost) {
   j["sweep"]["cohesion_ratio"] = {{"log", {0.1, 1.0, 3}}};
   j["replicas"] = {{"count", 2}, {"first_seed", 7}};
   // nlohmann::json sorts keys; the study keeps the file's order, so build the text by hand.
-  const std::string text = R"({"name": "t", "base_scene": )" + j["base_scene"].dump() +
-                           R"(, "sweep": {"thickness": [40, 60], "cohesion_ratio": {"log": [0.1, 1, 3]}},
+  const std::string text =
+      R"({"name": "t", "base_scene": )" + j["base_scene"].dump() +
+      R"(, "sweep": {"thickness": [40, 60], "cohesion_ratio": {"log": [0.1, 1, 3]}},
                               "replicas": {"count": 2, "first_seed": 7}})";
   const Study s = parse_study(text, ".", "test");
   ASSERT_EQ(s.cases.size(), 12u);
@@ -69,9 +68,15 @@ TEST(StudyFile, CartesianProductLastAxisFastestReplicasInnermost) {
 
 TEST(StudyFile, DerivesTensileStrengthStepAndWidthFromTheGroups) {
   json j = base_study();
-  j["fixed"] = {{"/ice/density", 900.0}, {"/gravity/g", 9.8}, {"thickness", 60.0},
-                {"step_length_ratio", 2.0}, {"slope", 0.5}, {"front_past_step_ratio", 3.0},
-                {"upstream_length_ratio", 6.0}, {"downstream_length_ratio", 8.0}, {"cells_per_thickness", 12.0}};
+  j["fixed"] = {{"/ice/density", 900.0},
+                {"/gravity/g", 9.8},
+                {"thickness", 60.0},
+                {"step_length_ratio", 2.0},
+                {"slope", 0.5},
+                {"front_past_step_ratio", 3.0},
+                {"upstream_length_ratio", 6.0},
+                {"downstream_length_ratio", 8.0},
+                {"cells_per_thickness", 12.0}};
   j["sweep"] = {{"cohesion_ratio", {0.05, 0.5}}};
   const Study s = parse(j);
   ASSERT_EQ(s.cases.size(), 2u);
@@ -143,7 +148,8 @@ TEST(StudyFile, BaseSceneFromAFileRelativeToTheStudy) {
 TEST(StudyFile, ResourcesAndMeasurementSettings) {
   json j = base_study();
   j["resources"] = {{"jobs", 3}, {"threads_per_case", 2}, {"case_time_limit_s", 60}};
-  j["measurement"] = {{"damage_threshold", 0.9}, {"window_min_x_m", 100.0}, {"surface_smoothing_bins", 5}};
+  j["measurement"] = {
+      {"damage_threshold", 0.9}, {"window_min_x_m", 100.0}, {"surface_smoothing_bins", 5}};
   const Study s = parse(j);
   EXPECT_EQ(s.resources.jobs, 3);
   EXPECT_EQ(s.resources.threads_per_case, 2);
@@ -171,62 +177,146 @@ TEST_P(InvalidStudy, IsRefusedWithItsOwnMessage) {
     FAIL() << GetParam().what << ": accepted";
   } catch (const InputError& e) {
     const std::string msg = e.what();
-    for (const auto& s : GetParam().expect) EXPECT_NE(msg.find(s), std::string::npos) << msg << "\nmissing: " << s;
+    for (const auto& s : GetParam().expect)
+      EXPECT_NE(msg.find(s), std::string::npos) << msg << "\nmissing: " << s;
     EXPECT_EQ(msg.find('\n'), std::string::npos) << "one line: " << msg;
   }
 }
 
 const BadStudy kBadStudies[] = {
-    {"log range with a non-positive bound", [](json& j) { j["sweep"] = {{"cohesion_ratio", {{"log", {-0.1, 1.0, 4}}}}}; },
+    {"log range with a non-positive bound",
+     [](json& j) {
+       j["sweep"] = {{"cohesion_ratio", {{"log", {-0.1, 1.0, 4}}}}};
+     },
      {"sweep.cohesion_ratio.log", "-0.1", "(0, inf)"}},
-    {"log range with zero", [](json& j) { j["sweep"] = {{"cohesion_ratio", {{"log", {0.0, 1.0, 4}}}}}; },
+    {"log range with zero",
+     [](json& j) {
+       j["sweep"] = {{"cohesion_ratio", {{"log", {0.0, 1.0, 4}}}}};
+     },
      {"sweep.cohesion_ratio.log", "bound 0"}},
-    {"count not an integer", [](json& j) { j["sweep"] = {{"cohesion_ratio", {{"linear", {0.1, 1.0, 2.5}}}}}; },
+    {"count not an integer",
+     [](json& j) {
+       j["sweep"] = {{"cohesion_ratio", {{"linear", {0.1, 1.0, 2.5}}}}};
+     },
      {"sweep.cohesion_ratio.linear", "count must be an integer"}},
-    {"count zero", [](json& j) { j["sweep"] = {{"cohesion_ratio", {{"linear", {0.1, 1.0, 0}}}}}; },
+    {"count zero",
+     [](json& j) {
+       j["sweep"] = {{"cohesion_ratio", {{"linear", {0.1, 1.0, 0}}}}};
+     },
      {"sweep.cohesion_ratio.linear", "count 0", "[1, 10000]"}},
-    {"range of two numbers", [](json& j) { j["sweep"] = {{"cohesion_ratio", {{"linear", {0.1, 1.0}}}}}; },
+    {"range of two numbers",
+     [](json& j) {
+       j["sweep"] = {{"cohesion_ratio", {{"linear", {0.1, 1.0}}}}};
+     },
      {"sweep.cohesion_ratio.linear", "[first, last, count]"}},
-    {"unknown range kind", [](json& j) { j["sweep"] = {{"cohesion_ratio", {{"geometric", {0.1, 1.0, 3}}}}}; },
+    {"unknown range kind",
+     [](json& j) {
+       j["sweep"] = {{"cohesion_ratio", {{"geometric", {0.1, 1.0, 3}}}}};
+     },
      {"sweep.cohesion_ratio", "must be a list of values"}},
-    {"empty list", [](json& j) { j["sweep"] = {{"cohesion_ratio", json::array()}}; },
+    {"empty list",
+     [](json& j) {
+       j["sweep"] = {{"cohesion_ratio", json::array()}};
+     },
      {"sweep.cohesion_ratio", "empty list"}},
-    {"cohesion ratio out of range", [](json& j) { j["fixed"] = {{"cohesion_ratio", -1.0}}; },
+    {"cohesion ratio out of range",
+     [](json& j) {
+       j["fixed"] = {{"cohesion_ratio", -1.0}};
+     },
      {"fixed.cohesion_ratio", "value -1", "(0, 10000]"}},
-    {"group value not a number", [](json& j) { j["sweep"] = {{"slope", {"steep"}}}; },
+    {"group value not a number",
+     [](json& j) {
+       j["sweep"] = {{"slope", {"steep"}}};
+     },
      {"sweep.slope", "must be a number"}},
-    {"unknown parameter", [](json& j) { j["sweep"] = {{"cohesion", {0.1}}}; },
+    {"unknown parameter",
+     [](json& j) {
+       j["sweep"] = {{"cohesion", {0.1}}};
+     },
      {"sweep.cohesion", "unknown parameter 'cohesion'", "cohesion_ratio"}},
-    {"pointer to no scene field", [](json& j) { j["fixed"] = {{"/ice/thicknes", 50.0}}; },
+    {"pointer to no scene field",
+     [](json& j) {
+       j["fixed"] = {{"/ice/thicknes", 50.0}};
+     },
      {"fixed./ice/thicknes", "not a scene parameter", "'thicknes'"}},
-    {"group and its scene field", [](json& j) { j["fixed"] = {{"cohesion_ratio", 0.1}, {"/ice/tensile_strength", 1e5}}; },
+    {"group and its scene field",
+     [](json& j) {
+       j["fixed"] = {{"cohesion_ratio", 0.1}, {"/ice/tensile_strength", 1e5}};
+     },
      {"cohesion_ratio", "/ice/tensile_strength", "give only one"}},
-    {"slope and step height ratio", [](json& j) { j["fixed"] = {{"slope", 1.0}, {"step_height_ratio", 1.0}}; },
+    {"slope and step height ratio",
+     [](json& j) {
+       j["fixed"] = {{"slope", 1.0}, {"step_height_ratio", 1.0}};
+     },
      {"slope", "step_height_ratio", "give only one"}},
-    {"slope of a vertical step", [](json& j) { j["fixed"] = {{"step_length_ratio", 0.0}, {"slope", 1.0}}; },
+    {"slope of a vertical step",
+     [](json& j) {
+       j["fixed"] = {{"step_length_ratio", 0.0}, {"slope", 1.0}};
+     },
      {"case 0", "vertical", "step_height_ratio"}},
-    {"width ratio in 2D", [](json& j) { j["fixed"] = {{"width_ratio", 1.0}}; }, {"width_ratio", "3D", "dim 2"}},
-    {"same parameter fixed and swept", [](json& j) { j["fixed"] = {{"thickness", 40.0}}; j["sweep"] = {{"thickness", {40.0, 60.0}}}; },
+    {"width ratio in 2D",
+     [](json& j) {
+       j["fixed"] = {{"width_ratio", 1.0}};
+     },
+     {"width_ratio", "3D", "dim 2"}},
+    {"same parameter fixed and swept",
+     [](json& j) {
+       j["fixed"] = {{"thickness", 40.0}};
+       j["sweep"] = {{"thickness", {40.0, 60.0}}};
+     },
      {"sweep.thickness", "also set in fixed"}},
-    {"repeated value", [](json& j) { j["sweep"] = {{"cohesion_ratio", {0.1, 0.2, 0.1}}}; },
+    {"repeated value",
+     [](json& j) {
+       j["sweep"] = {{"cohesion_ratio", {0.1, 0.2, 0.1}}};
+     },
      {"cases 0", "and 2", "same parameters"}},
-    {"replicas without jitter", [](json& j) { j["replicas"] = 3; }, {"replicas", "/numerics/jitter"}},
-    {"replicas out of range", [](json& j) { j["replicas"] = 0; }, {"replicas", "value 0", "[1, 1000]"}},
+    {"replicas without jitter",
+     [](json& j) { j["replicas"] = 3; },
+     {"replicas", "/numerics/jitter"}},
+    {"replicas out of range",
+     [](json& j) { j["replicas"] = 0; },
+     {"replicas", "value 0", "[1, 1000]"}},
     {"missing name", [](json& j) { j.erase("name"); }, {"name", "required"}},
     {"name with a slash", [](json& j) { j["name"] = "a/b"; }, {"name", "'a/b'"}},
     {"missing base scene", [](json& j) { j.erase("base_scene"); }, {"base_scene", "required"}},
-    {"base scene file missing", [](json& j) { j["base_scene"] = "no/such/scene.json"; }, {"base_scene", "cannot open"}},
-    {"unknown top-level key", [](json& j) { j["sweeps"] = json::object(); }, {"sweeps", "unknown key"}},
-    {"scene invalid for a case", [](json& j) { j["sweep"] = {{"thickness", {40.0, 20.0}}}; },
+    {"base scene file missing",
+     [](json& j) { j["base_scene"] = "no/such/scene.json"; },
+     {"base_scene", "cannot open"}},
+    {"unknown top-level key",
+     [](json& j) { j["sweeps"] = json::object(); },
+     {"sweeps", "unknown key"}},
+    {"scene invalid for a case",
+     [](json& j) {
+       j["sweep"] = {{"thickness", {40.0, 20.0}}};
+     },
      {"case 1 (thickness=20)", "numerics.dx", "too coarse"}},
-    {"unknown scene key", [](json& j) { j["base_scene"]["ice"]["colour"] = "blue"; }, {"case 0", "ice.colour", "unknown key"}},
-    {"jobs negative", [](json& j) { j["resources"] = {{"jobs", -1}}; }, {"resources.jobs", "value -1", "[0, 1024]"}},
-    {"unknown resource", [](json& j) { j["resources"] = {{"cores", 2}}; }, {"resources.cores", "unknown key"}},
-    {"unknown measurement setting", [](json& j) { j["measurement"] = {{"threshold", 0.9}}; },
+    {"unknown scene key",
+     [](json& j) { j["base_scene"]["ice"]["colour"] = "blue"; },
+     {"case 0", "ice.colour", "unknown key"}},
+    {"jobs negative",
+     [](json& j) {
+       j["resources"] = {{"jobs", -1}};
+     },
+     {"resources.jobs", "value -1", "[0, 1024]"}},
+    {"unknown resource",
+     [](json& j) {
+       j["resources"] = {{"cores", 2}};
+     },
+     {"resources.cores", "unknown key"}},
+    {"unknown measurement setting",
+     [](json& j) {
+       j["measurement"] = {{"threshold", 0.9}};
+     },
      {"measurement.threshold", "unknown key"}},
-    {"damage threshold out of range", [](json& j) { j["measurement"] = {{"damage_threshold", 1.5}}; },
+    {"damage threshold out of range",
+     [](json& j) {
+       j["measurement"] = {{"damage_threshold", 1.5}};
+     },
      {"measurement.damage_threshold", "1.5", "(0, 1)"}},
-    {"cells per thickness too few", [](json& j) { j["fixed"] = {{"cells_per_thickness", 2.0}}; },
+    {"cells per thickness too few",
+     [](json& j) {
+       j["fixed"] = {{"cells_per_thickness", 2.0}};
+     },
      {"fixed.cells_per_thickness", "value 2", "[4, 10000]"}},
 };
 
@@ -238,7 +328,8 @@ TEST(StudyFile, NotJsonIsRefused) {
     parse_study("{\"name\": \"x\", ", ".", "broken.json");
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("broken.json: not valid JSON"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("broken.json: not valid JSON"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -264,7 +355,8 @@ namespace {
 // Every study shipped in studies/ loads, and quick.json spans weak to strong ice in 2D.
 TEST(ShippedStudies, AllLoadAndQuickSpansWeakToStrongIce) {
   const std::filesystem::path dir = std::filesystem::path(CREVASSE_SOURCE_DIR) / "studies";
-  for (const char* name : {"quick", "spacing_vs_cohesion", "slope", "step_length", "three_d", "accuracy_cost"}) {
+  for (const char* name :
+       {"quick", "spacing_vs_cohesion", "slope", "step_length", "three_d", "accuracy_cost"}) {
     SCOPED_TRACE(name);
     const Study s = load_study_file(dir / (std::string(name) + ".json"));
     EXPECT_EQ(s.name, name);
@@ -286,7 +378,8 @@ TEST(ShippedStudies, AllLoadAndQuickSpansWeakToStrongIce) {
   for (const auto& c : three.cases) {
     EXPECT_EQ(c.scene.dim, 3);
     bool matched = false;
-    for (const auto& q : quick.cases) matched = matched || q.scene.tensile_strength == c.scene.tensile_strength;
+    for (const auto& q : quick.cases)
+      matched = matched || q.scene.tensile_strength == c.scene.tensile_strength;
     EXPECT_TRUE(matched) << c.label;
   }
 }
