@@ -1,0 +1,126 @@
+// SPEC §4: the step is assembled from exactly the effects a scene names. An effect not named
+// adds no stage and no per-particle storage; an elastic scene never runs the return mapping.
+#include <gtest/gtest.h>
+
+#include "engine/simulation.hpp"
+#include "scene_builders.hpp"
+
+namespace crevasse {
+namespace {
+
+using test::box_scene;
+using test::finish;
+using test::has_stage;
+
+SceneConfig block(std::initializer_list<Effect> effects) {
+  SceneConfig s = box_scene(2, {0, 0, 0}, {6, 3, 0}, {0, -3, 0}, {6, 8, 0}, effects, 1.0);
+  s.bed_shape = "flat";
+  s.wall_axes = {0};
+  return finish(s);
+}
+
+TEST(Effects, ElasticSceneRunsNoReturnMapping) {
+  Simulation<2> sim(block({Effect::gravity, Effect::basal_friction}));
+  for (int i = 0; i < 20; ++i) sim.step();
+  EXPECT_EQ(sim.return_map_evaluations(), 0);
+  EXPECT_FALSE(has_stage(sim.stages(), "g2p_return_mapping"));
+  EXPECT_TRUE(has_stage(sim.stages(), "g2p_elastic"));
+  EXPECT_FALSE(sim.particles().has_plastic_state());  // no ε_v^p storage
+  EXPECT_EQ(sim.cap_dissipated_energy(), 0.0);
+}
+
+TEST(Effects, PlasticSceneRunsTheReturnMappingOnEveryParticleEveryStep) {
+  Simulation<2> sim(block({Effect::gravity, Effect::basal_friction, Effect::plasticity}));
+  const int steps = 20;
+  for (int i = 0; i < steps; ++i) sim.step();
+  EXPECT_TRUE(has_stage(sim.stages(), "g2p_return_mapping"));
+  EXPECT_FALSE(has_stage(sim.stages(), "g2p_elastic"));
+  EXPECT_EQ(sim.return_map_evaluations(),
+            static_cast<std::int64_t>(steps) * static_cast<std::int64_t>(sim.particles().size()));
+  EXPECT_TRUE(sim.particles().has_plastic_state());
+}
+
+// A plastic scene whose strengths are never reached computes exactly what the elastic one does:
+// the return mapping adds cost, never a change, inside the elastic domain.
+TEST(Effects, UnreachedPlasticityGivesTheElasticResultBitForBit) {
+  SceneConfig elastic = block({Effect::gravity, Effect::basal_friction, Effect::box_walls});
+  SceneConfig plastic = block({Effect::gravity, Effect::basal_friction, Effect::box_walls,
+                               Effect::plasticity});
+  plastic.tensile_strength = 1e9;
+  plastic.shear_strength = 1e10;
+  Simulation<2> a(elastic), b(plastic);
+  for (int i = 0; i < 200; ++i) {
+    a.step();
+    b.step();
+  }
+  ASSERT_EQ(a.particles().size(), b.particles().size());
+  for (std::size_t p = 0; p < a.particles().size(); ++p) {
+    EXPECT_EQ(a.particles().x[p], b.particles().x[p]);
+    EXPECT_EQ(a.particles().tau[p], b.particles().tau[p]);
+  }
+  EXPECT_GT(b.return_map_evaluations(), 0);
+}
+
+TEST(Effects, StagesFollowTheEffectList) {
+  Simulation<2> bare(block({}));
+  const auto& st = bare.stages();
+  for (const char* absent : {"basal_friction", "bed_projection", "box_walls", "lateral_walls",
+                             "velocity_boundaries", "drive", "outflow", "settle_damping",
+                             "grid_velocity_gravity", "g2p_return_mapping"}) {
+    EXPECT_FALSE(has_stage(st, absent)) << absent;
+  }
+  EXPECT_TRUE(has_stage(st, "grid_velocity"));  // no gravity term
+
+  SceneConfig full_scene = block({Effect::gravity, Effect::basal_friction, Effect::box_walls,
+                                  Effect::velocity_boundaries, Effect::outflow,
+                                  Effect::plasticity, Effect::softening});
+  Simulation<2> full(full_scene);
+  for (const char* present : {"basal_friction", "bed_projection", "box_walls",
+                              "velocity_boundaries", "outflow", "grid_velocity_gravity",
+                              "g2p_return_mapping"}) {
+    EXPECT_TRUE(has_stage(full.stages(), present)) << present;
+  }
+  EXPECT_FALSE(has_stage(full.stages(), "lateral_walls"));  // 3D only, and not named
+  EXPECT_FALSE(has_stage(full.stages(), "drive"));
+  full.step();
+  for (const auto& s : full.stages()) EXPECT_EQ(s.calls, 1) << s.name;
+}
+
+TEST(Effects, LateralWallsOnlyIn3dWhenNamed) {
+  SceneConfig s = box_scene(3, {0, 0, 0}, {4, 2, 2}, {0, 0, -2}, {4, 2, 6},
+                            {Effect::lateral_walls}, 1.0);
+  Simulation<3> sim(finish(s));
+  EXPECT_TRUE(has_stage(sim.stages(), "lateral_walls"));
+}
+
+TEST(Effects, DriveStorageOnlyWithDrive) {
+  Simulation<2> without(block({Effect::gravity}));
+  EXPECT_TRUE(without.particles().drive_x0.empty());
+}
+
+// Settling runs only for a geostatic start under gravity, and its damping stage only then.
+TEST(Effects, SettlingOnlyForGeostaticStartUnderGravity) {
+  SceneConfig geo = block({Effect::gravity, Effect::basal_friction});
+  geo.initial_stress = "geostatic";
+  geo.settle_time = -1.0;
+  geo = finish(geo);
+  EXPECT_GT(geo.settle_time, 0.0);
+  Simulation<2> sim(geo);
+  EXPECT_TRUE(has_stage(sim.stages(), "settle_damping"));
+  sim.settle();
+  EXPECT_EQ(sim.time(), 0.0);  // the clock starts after settling
+  EXPECT_EQ(sim.steps(), 0);
+
+  SceneConfig none = block({Effect::gravity, Effect::basal_friction});
+  EXPECT_EQ(none.settle_time, 0.0);
+}
+
+// Without gravity nothing moves a block at rest: no hidden body force.
+TEST(Effects, NoGravityNoMotion) {
+  Simulation<2> sim(block({Effect::basal_friction}));
+  for (int i = 0; i < 50; ++i) sim.step();
+  EXPECT_EQ(sim.kinetic_energy(), 0.0);
+}
+
+}  // namespace
+}  // namespace crevasse
