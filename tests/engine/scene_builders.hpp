@@ -50,7 +50,9 @@ inline SceneConfig finish(SceneConfig s) {
 
 // Lamé parameters and wave speeds of the test ice.
 inline double lame_mu() { return kYoung / (2.0 * (1.0 + kPoisson)); }
-inline double lame_lambda() { return kYoung * kPoisson / ((1.0 + kPoisson) * (1.0 - 2.0 * kPoisson)); }
+inline double lame_lambda() {
+  return kYoung * kPoisson / ((1.0 + kPoisson) * (1.0 - 2.0 * kPoisson));
+}
 // P-wave (constrained, uniaxial-strain) modulus λ + 2μ and speed.
 inline double p_wave_modulus() { return lame_lambda() + 2.0 * lame_mu(); }
 

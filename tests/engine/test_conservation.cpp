@@ -58,8 +58,8 @@ TEST(Conservation, MassExactWithoutOutflow3d) { check_mass_exact<3>(); }
 
 // Outflow: ice past the far end leaves the scene, and its mass is booked as removed.
 TEST(Conservation, MassBookedWhenIceFlowsOut) {
-  SceneConfig s = box_scene(2, {0, 0, 0}, {10, 2, 0}, {-2, -2, 0}, {20, 6, 0}, {Effect::outflow},
-                            1.0);
+  SceneConfig s =
+      box_scene(2, {0, 0, 0}, {10, 2, 0}, {-2, -2, 0}, {20, 6, 0}, {Effect::outflow}, 1.0);
   s = finish(s);
   Simulation<2> sim(s);
   for (auto& v : sim.mutable_particles().v) v[0] = 50.0;  // the whole block moves downstream

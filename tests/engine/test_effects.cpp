@@ -44,8 +44,8 @@ TEST(Effects, PlasticSceneRunsTheReturnMappingOnEveryParticleEveryStep) {
 // the return mapping adds cost, never a change, inside the elastic domain.
 TEST(Effects, UnreachedPlasticityGivesTheElasticResultBitForBit) {
   SceneConfig elastic = block({Effect::gravity, Effect::basal_friction, Effect::box_walls});
-  SceneConfig plastic = block({Effect::gravity, Effect::basal_friction, Effect::box_walls,
-                               Effect::plasticity});
+  SceneConfig plastic =
+      block({Effect::gravity, Effect::basal_friction, Effect::box_walls, Effect::plasticity});
   plastic.tensile_strength = 1e9;
   plastic.shear_strength = 1e10;
   Simulation<2> a(elastic), b(plastic);
@@ -64,20 +64,20 @@ TEST(Effects, UnreachedPlasticityGivesTheElasticResultBitForBit) {
 TEST(Effects, StagesFollowTheEffectList) {
   Simulation<2> bare(block({}));
   const auto& st = bare.stages();
-  for (const char* absent : {"basal_friction", "bed_projection", "box_walls", "lateral_walls",
-                             "velocity_boundaries", "drive", "outflow", "settle_damping",
-                             "grid_velocity_gravity", "g2p_return_mapping"}) {
+  for (const char* absent :
+       {"basal_friction", "bed_projection", "box_walls", "lateral_walls", "velocity_boundaries",
+        "drive", "outflow", "settle_damping", "grid_velocity_gravity", "g2p_return_mapping"}) {
     EXPECT_FALSE(has_stage(st, absent)) << absent;
   }
   EXPECT_TRUE(has_stage(st, "grid_velocity"));  // no gravity term
 
-  SceneConfig full_scene = block({Effect::gravity, Effect::basal_friction, Effect::box_walls,
-                                  Effect::velocity_boundaries, Effect::outflow,
-                                  Effect::plasticity, Effect::softening});
+  SceneConfig full_scene =
+      block({Effect::gravity, Effect::basal_friction, Effect::box_walls,
+             Effect::velocity_boundaries, Effect::outflow, Effect::plasticity, Effect::softening});
   Simulation<2> full(full_scene);
-  for (const char* present : {"basal_friction", "bed_projection", "box_walls",
-                              "velocity_boundaries", "outflow", "grid_velocity_gravity",
-                              "g2p_return_mapping"}) {
+  for (const char* present :
+       {"basal_friction", "bed_projection", "box_walls", "velocity_boundaries", "outflow",
+        "grid_velocity_gravity", "g2p_return_mapping"}) {
     EXPECT_TRUE(has_stage(full.stages(), present)) << present;
   }
   EXPECT_FALSE(has_stage(full.stages(), "lateral_walls"));  // 3D only, and not named
@@ -87,8 +87,8 @@ TEST(Effects, StagesFollowTheEffectList) {
 }
 
 TEST(Effects, LateralWallsOnlyIn3dWhenNamed) {
-  SceneConfig s = box_scene(3, {0, 0, 0}, {4, 2, 2}, {0, 0, -2}, {4, 2, 6},
-                            {Effect::lateral_walls}, 1.0);
+  SceneConfig s =
+      box_scene(3, {0, 0, 0}, {4, 2, 2}, {0, 0, -2}, {4, 2, 6}, {Effect::lateral_walls}, 1.0);
   Simulation<3> sim(finish(s));
   EXPECT_TRUE(has_stage(sim.stages(), "lateral_walls"));
 }

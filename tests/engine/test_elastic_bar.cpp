@@ -27,8 +27,8 @@ using test::finish;
 
 constexpr double kLength = 80.0;  // 80 cells: the wall and the bar end are each known to ~dx/2
 constexpr double kDx = 1.0;
-constexpr double kSide = 2.0;     // lateral size [m] (2 cells)
-constexpr double kV0 = 1.0;       // impact speed [m/s]: strain V0/c_p ≈ 1e-3, small
+constexpr double kSide = 2.0;  // lateral size [m] (2 cells)
+constexpr double kV0 = 1.0;    // impact speed [m/s]: strain V0/c_p ≈ 1e-3, small
 
 struct Impact {
   double c_from_crossing = 0.0;
@@ -39,7 +39,8 @@ struct Impact {
 
 template <int Dim>
 Impact impact() {
-  std::array<double, 3> hi{kLength, kSide, 0.0}, dlo{0.0, 0.0, 0.0}, dhi{kLength + 40.0, kSide, 0.0};
+  std::array<double, 3> hi{kLength, kSide, 0.0}, dlo{0.0, 0.0, 0.0},
+      dhi{kLength + 40.0, kSide, 0.0};
   std::vector<int> walls{0, 1};
   if (Dim == 3) {
     hi = {kLength, kSide, kSide};

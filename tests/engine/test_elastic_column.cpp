@@ -158,8 +158,8 @@ void check_no_plastic_strain_at_start() {
   sim.settle();
   double max_tension = 0.0;
   for (const double p : sim.snapshot().pressure_pa) max_tension = std::max(max_tension, -p);
-  std::cout << Dim << "D settled column: largest tension " << max_tension << " Pa (c = "
-            << s.tensile_strength << " Pa)\n";
+  std::cout << Dim << "D settled column: largest tension " << max_tension
+            << " Pa (c = " << s.tensile_strength << " Pa)\n";
   // The noise must be far below c for the check below to mean anything.
   EXPECT_LT(max_tension, 0.1 * s.tensile_strength);
   // One first-mode period of the plastic model from t = 0: nothing yields.

@@ -30,8 +30,8 @@ SceneConfig incline_scene(double theta_deg, double mu) {
     dlo = {0.0, 0.0, -3.0};
     dhi = {30.0, 2.0, 10.0};
   }
-  SceneConfig s = box_scene(Dim, {2.0, 0.0, 0.0}, hi, dlo, dhi,
-                            {Effect::gravity, Effect::basal_friction}, kDx);
+  SceneConfig s =
+      box_scene(Dim, {2.0, 0.0, 0.0}, hi, dlo, dhi, {Effect::gravity, Effect::basal_friction}, kDx);
   s.box_max[0] = 18.0;
   s.bed_shape = "flat";
   s.flat_bed_z = 0.0;
@@ -106,8 +106,8 @@ void check_sticking() {
   const double theta = 10.0, mu = 0.3;
   ASSERT_LT(std::tan(theta * std::numbers::pi / 180.0), mu);
   const Slide r = slide<Dim>(theta, mu, 1.0);
-  const double frictionless = 0.5 * test::kG * std::sin(theta * std::numbers::pi / 180.0) *
-                              r.duration * r.duration;
+  const double frictionless =
+      0.5 * test::kG * std::sin(theta * std::numbers::pi / 180.0) * r.duration * r.duration;
   std::cout << Dim << "D sticking block: moved " << r.displacement << " m (frictionless "
             << frictionless << " m)\n";
   EXPECT_LT(std::abs(r.displacement), 1e-3 * frictionless);

@@ -26,10 +26,11 @@ namespace {
 using test::box_scene;
 using test::finish;
 
-constexpr double kLength = 10.0;     // bar length [m]
-constexpr double kThickness = 2.0;   // cross-section per unit depth [m²/m]
-constexpr double kGrip = 1.0;        // grip length at each end [m]
-constexpr double kPullSpeed = 0.1;   // each grip [m/s]; ρ c V ≈ 0.1 MPa, a fifth of the seed's strength
+constexpr double kLength = 10.0;    // bar length [m]
+constexpr double kThickness = 2.0;  // cross-section per unit depth [m²/m]
+constexpr double kGrip = 1.0;       // grip length at each end [m]
+constexpr double kPullSpeed =
+    0.1;  // each grip [m/s]; ρ c V ≈ 0.1 MPa, a fifth of the seed's strength
 constexpr double kSeedStrength = 0.2;
 
 struct BarResult {
@@ -38,10 +39,9 @@ struct BarResult {
 };
 
 BarResult pull_bar_apart(double dx, double t_end) {
-  SceneConfig s = box_scene(2, {0, 0, 0}, {kLength, kThickness, 0}, {-4, -2, 0},
-                            {kLength + 4, kThickness + 2, 0},
-                            {Effect::plasticity, Effect::softening, Effect::velocity_boundaries},
-                            dx);
+  SceneConfig s = box_scene(
+      2, {0, 0, 0}, {kLength, kThickness, 0}, {-4, -2, 0}, {kLength + 4, kThickness + 2, 0},
+      {Effect::plasticity, Effect::softening, Effect::velocity_boundaries}, dx);
   s.tensile_strength = 1.0e6;
   s.shear_strength = 1.0e7;
   // ζ = 500 at dx = 1 m: full opening (ζ ε_v^p ≈ 5) needs a few cm, so the test is short;
@@ -70,8 +70,8 @@ BarResult pull_bar_apart(double dx, double t_end) {
   BarResult r;
   r.energy_per_area = (sim.cap_dissipated_energy() - e0) / kThickness;
   r.nominal_band = s.tensile_strength * dx / s.softening_zeta;
-  std::cout << "dx " << dx << " m: dissipated " << r.energy_per_area << " J/m² = "
-            << r.energy_per_area / r.nominal_band << " × c·dx/ζ\n";
+  std::cout << "dx " << dx << " m: dissipated " << r.energy_per_area
+            << " J/m² = " << r.energy_per_area / r.nominal_band << " × c·dx/ζ\n";
   return r;
 }
 
@@ -88,8 +88,8 @@ TEST(MeshObjectivity, SameFractureEnergyAtDxAndHalfDx) {
   const BarResult medium = pull_bar_apart(0.5, kEndTime);
   // The bar did break: at least the seed cell opened fully (ΔE ≥ 80% of one cell's worth).
   EXPECT_GT(coarse.energy_per_area, 0.8 * coarse.nominal_band);
-  const double rel = std::abs(medium.energy_per_area - coarse.energy_per_area) /
-                     coarse.energy_per_area;
+  const double rel =
+      std::abs(medium.energy_per_area - coarse.energy_per_area) / coarse.energy_per_area;
   std::cout << "G(dx/2) vs G(dx): rel. difference " << rel << "\n";
   EXPECT_LT(rel, kObjectivityTolerance);
 }

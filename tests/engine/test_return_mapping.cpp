@@ -62,7 +62,7 @@ struct MaterialCase {
 
 // Several strengths and softening rates, all with ζ < K/c (implicit cap): K ≈ 0.83–0.96 GPa.
 const MaterialCase kImplicitCases[] = {
-    {1.0e6, 0.0, 1.0e7},   {1.0e6, 50.0, 1.0e7}, {1.0e6, 500.0, 1.0e7},
+    {1.0e6, 0.0, 1.0e7},    {1.0e6, 50.0, 1.0e7},  {1.0e6, 500.0, 1.0e7},
     {1.0e5, 5000.0, 1.0e6}, {5.0e6, 100.0, 2.0e6}, {2.0e5, 10.0, 5.0e5},
 };
 
@@ -113,7 +113,9 @@ void check_admissible_and_exact(std::uint64_t seed) {
         // Returned exactly onto the cylinder.
         EXPECT_NEAR(out.q, shear_strength(pr, eps_new, out.p), kYieldTol * mc.c);
       }
-      if (!r.cap_active && !r.shear_active) EXPECT_EQ(r.eps, eps_tr);
+      if (!r.cap_active && !r.shear_active) {
+        EXPECT_EQ(r.eps, eps_tr);
+      }
     }
   }
   // The random states exercise both branches many times (no vacuous pass).
@@ -202,10 +204,11 @@ TEST(ReturnMapping, ImplicitCapIncrementSolvesTheConsistencyEquation) {
 }
 
 // Explicit branch (ζ ≥ K/c): a bar of ice stretched in uniaxial volumetric tension with steps
-// from small (1e-6, a thousandth of the yield strain c/K) to enormous (0.1). Stability: the pressure stays in [−c, 0] — never more tension than
-// intact ice carries, never compression from an overshooting return — it is the start-of-step
-// cap exactly, it rises monotonically to 0 as the material opens, and ε_v^p grows without
-// blowing up (each increment is bounded by the trial stretch).
+// from small (1e-6, a thousandth of the yield strain c/K) to enormous (0.1). Stability: the
+// pressure stays in [−c, 0] — never more tension than intact ice carries, never compression from an
+// overshooting return — it is the start-of-step cap exactly, it rises monotonically to 0 as the
+// material opens, and ε_v^p grows without blowing up (each increment is bounded by the trial
+// stretch).
 template <int Dim>
 void check_explicit_branch_stable(double step) {
   const double c = 1.0e6;
@@ -226,7 +229,9 @@ void check_explicit_branch_stable(double step) {
     ASSERT_LE(p, kYieldTol * c);
     if (r.cap_active) {
       EXPECT_NEAR(p, cap_pressure(pr, eps_v_p), kYieldTol * c);  // explicit: start-of-step cap
-      if (yielded) EXPECT_GE(p, last_p - kYieldTol * c);           // softening is monotone
+      if (yielded) {
+        EXPECT_GE(p, last_p - kYieldTol * c);  // softening is monotone
+      }
       yielded = true;
       last_p = p;
     }

@@ -36,7 +36,7 @@ void expect_refused(const json& j, const std::string& field) {
 TEST(SceneValidation, ValidSceneIsAcceptedAndRoundTrips) {
   const SceneConfig s = scene_from_json(valid_scene());
   EXPECT_EQ(s.ice_thickness, 100.0);
-  EXPECT_EQ(s.upstream_length, 500.0);  // default 5·H_i
+  EXPECT_EQ(s.upstream_length, 500.0);        // default 5·H_i
   EXPECT_DOUBLE_EQ(s.softening_zeta, 500.0);  // ζ_ref at dx = dx_ref
   // The canonical JSON reads back to the same canonical JSON.
   const json canonical = scene_to_json(s);
