@@ -16,7 +16,23 @@ struct CappedVonMisesParams {
   double tensile_strength_c = 0.0;  // c [Pa], p_c(0) = −c
   double shear_strength_qy = 0.0;   // q_y [Pa]
   double softening_zeta = 0.0;      // ζ [-]; 0 = perfectly plastic cap
+  // Damage also softens the shear strength, q_y·exp(−ζ ε_v^p): without it a fully opened
+  // particle keeps q_y and, under overburden, still carries horizontal tension of the order of
+  // ρ g d (the cap bounds only the mean stress), so a cracked block hangs on as a hinge instead
+  // of separating. The closest public code of this family (matter's capped von Mises, Blatny &
+  // Gaume 2025, GMD 18, 9149) softens q_y with the same rate. docs/model.md discusses it.
+  bool damage_softens_shear = true;
+  // Residual strength of damaged ice as rubble: q_y never drops below M·max(p, 0) (a
+  // Drucker–Prager-like friction line; M = 6 sin φ/(3 − sin φ) = 1.2 for φ = 30°). 0 = none.
+  double residual_friction_m = 0.0;
 };
+
+// Shear strength at a given opening: q_y, or q_y·exp(−ζ ε_v^p) when damage softens shear.
+inline double shear_strength(const CappedVonMisesParams& p, double eps_v_p, double pressure) {
+  if (!p.damage_softens_shear) return p.shear_strength_qy;
+  const double intact = p.shear_strength_qy * std::exp(-p.softening_zeta * eps_v_p);
+  return std::min(p.shear_strength_qy, std::max(intact, p.residual_friction_m * std::max(pressure, 0.0)));
+}
 
 template <int Dim>
 struct ReturnResult {
@@ -76,8 +92,9 @@ inline ReturnResult<Dim> return_map_capped_von_mises(const Vec<Dim>& eps_trial, 
   const double tr_new = r.eps.sum();
   Vec<Dim> dev = r.eps.array() - tr_new / Dim;
   const double q_trial = std::sqrt(6.0) * m.mu * dev.norm();  // q = sqrt(3/2)·2μ‖dev ε‖
-  if (q_trial > p.shear_strength_qy) {
-    dev *= p.shear_strength_qy / q_trial;
+  const double q_y = shear_strength(p, eps_v_p + r.delta_eps_v, -k * tr_new);
+  if (q_trial > q_y) {
+    dev *= q_y / q_trial;
     r.eps = (dev.array() + tr_new / Dim).matrix();
     r.shear_active = true;
   }

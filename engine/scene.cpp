@@ -193,6 +193,7 @@ void SceneConfig::resolve() {
     check_range("ice.softening.fracture_energy", fracture_energy, 0.0, 1e12);
     check_range("ice.softening.zeta_ref", zeta_ref, 0.0, 1e9, true);
     check_range("ice.softening.dx_ref", dx_ref, 0.0, 1e4, true);
+    check_range("ice.softening.residual_friction", residual_friction, 0.0, 10.0);
     if (softening_zeta == 0.0) {
       softening_zeta = fracture_energy > 0 ? tensile_strength * dx / fracture_energy
                                            : zeta_ref * dx / dx_ref;
@@ -201,6 +202,7 @@ void SceneConfig::resolve() {
     softening_zeta = 0.0;
   }
 
+  if (body == "slab") check_range("ice.thickness", ice_thickness, 0.0, 1e5, true);
   if (settle_time < 0.0) {
     const double h = body == "slab" ? ice_thickness : box_max[dim - 1] - box_min[dim - 1];
     settle_time = (initial_stress == "geostatic" && has(Effect::gravity)) ? 30.0 * h / p_wave_speed() : 0.0;
@@ -288,6 +290,8 @@ SceneConfig scene_from_json(const nlohmann::json& j) {
       so.number("dx_ref", s.dx_ref);
       so.number("zeta", s.softening_zeta);
       so.number("fracture_energy", s.fracture_energy);
+      so.boolean("damage_softens_shear", s.damage_softens_shear);
+      so.number("residual_friction", s.residual_friction);
       so.refuse_unknown();
     }
     o.refuse_unknown();
@@ -402,7 +406,9 @@ nlohmann::json scene_to_json(const SceneConfig& s) {
          {{"zeta_ref", s.zeta_ref},
           {"dx_ref", s.dx_ref},
           {"zeta", s.softening_zeta},
-          {"fracture_energy", s.fracture_energy}}}}},
+          {"fracture_energy", s.fracture_energy},
+          {"damage_softens_shear", s.damage_softens_shear},
+          {"residual_friction", s.residual_friction}}}}},
       {"bed",
        {{"shape", s.bed_shape},
         {"step_height", s.step_height},

@@ -48,6 +48,8 @@ struct SceneConfig {
   double dx_ref = 10.0;
   double softening_zeta = 0.0;        // resolved ζ (0 until resolve())
   double fracture_energy = 0.0;       // G [J/m²]; 0 = derived from zeta_ref
+  bool damage_softens_shear = true;   // q_y·exp(−ζ ε_v^p) (see capped_von_mises.hpp)
+  double residual_friction = 1.2;     // M: damaged ice keeps q ≤ M·p (rubble, φ ≈ 30°)
 
   // Geometry
   std::string body = "slab";          // "slab": glacier on the plateau; "box": box_min..box_max

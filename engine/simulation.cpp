@@ -49,6 +49,8 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   plastic_.tensile_strength_c = scene_.tensile_strength;
   plastic_.shear_strength_qy = scene_.shear_strength;
   plastic_.softening_zeta = scene_.has(Effect::softening) ? scene_.softening_zeta : 0.0;
+  plastic_.damage_softens_shear = scene_.damage_softens_shear;
+  plastic_.residual_friction_m = scene_.residual_friction;
   grid_.dx = scene_.dx;
   domain_lo_ = to_vec<Dim>(scene_.domain_min);
   domain_hi_ = to_vec<Dim>(scene_.domain_max);
@@ -656,7 +658,7 @@ double Simulation<Dim>::max_yield_violation() const {
     const double q = von_mises_of<Dim>(particles_.tau[p]);
     const double pc = cap_pressure(plastic_, particles_.eps_v_p[p]);
     worst = std::max({worst, (pc - pr) / plastic_.tensile_strength_c,
-                      (q - plastic_.shear_strength_qy) / plastic_.tensile_strength_c});
+                      (q - shear_strength(plastic_, particles_.eps_v_p[p], pr)) / plastic_.tensile_strength_c});
   }
   return worst;
 }

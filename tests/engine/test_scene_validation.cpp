@@ -118,7 +118,7 @@ TEST(SceneValidation, OutOfRangeValuesAreRefused) {
 // ice.settle_time ("value -0.1238 is outside the allowed range [0, 1e+06]"), because resolve()
 // derives the default settle_time = 30·H_i/c_p from the thickness before it checks the
 // thickness. The user is told to fix a field they never wrote.
-TEST(SceneValidation, DISABLED_NegativeThicknessIsNamed) {
+TEST(SceneValidation, NegativeThicknessIsNamed) {
   json j = valid_scene();
   j["ice"]["thickness"] = -5.0;
   expect_refused(j, "ice.thickness");
