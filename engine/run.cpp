@@ -31,11 +31,13 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
 
   int output_index = 0;
   double next_output = 0.0;
+  double last_output_time = -1.0;
   auto maybe_output = [&] {
     if (!obs || scene.vtu_interval <= 0) return;
     if (sim.time() + 1e-12 >= next_output) {
       obs->on_output(sim.snapshot(), output_index++);
-      next_output += scene.vtu_interval * std::max(1.0, std::floor((sim.time() - next_output) / scene.vtu_interval) + 1.0);
+      last_output_time = sim.time();
+      while (next_output <= sim.time() + 1e-12) next_output += scene.vtu_interval;
     }
   };
   maybe_output();
@@ -83,6 +85,9 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
   out.removed_mass = sim.removed_mass();
   out.final_particles = sim.particles().size();
   out.final_snapshot = sim.snapshot();
+  // The last state is always among the snapshots, unless the last interval just wrote it.
+  if (obs && scene.vtu_interval > 0 && last_output_time < sim.time())
+    obs->on_output(out.final_snapshot, output_index++);
   for (const auto& s : sim.stages()) out.stage_seconds[s.name] = {{"seconds", s.seconds}, {"calls", s.calls}};
   out.wall_s = std::chrono::duration<double>(clock::now() - t0).count();
   return out;

@@ -1,7 +1,6 @@
 #!/usr/bin/env bash
 # README's first set-up command: install what is missing, build (Release), and run the main job,
-# the quick study, into results/quick.db (resumes if interrupted), then print its status and
-# render one example case's side view under results/quick_example/.
+# the quick study, into results/quick.db (resumes if interrupted), then print its status.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh

@@ -77,7 +77,6 @@ int run_command(const RunCommandOptions& opt) {
   CliObserver obs(out, opt.quiet);
   RunSummary r = run_scene(scene, &obs);
   obs.finish();
-  if (scene.vtu_interval > 0) obs.on_output(r.final_snapshot, 99999);
 
   nlohmann::json summary = {
       {"scene", scene.name},

@@ -1,6 +1,7 @@
 #pragma once
 // Small scenes for the engine tests, built in code. Every builder returns a resolve()d
 // SceneConfig; callers change fields and call resolve() again only through finish().
+#include <algorithm>
 #include <array>
 #include <initializer_list>
 #include <string>
@@ -74,6 +75,34 @@ inline std::array<double, 2> fit_line(const std::vector<double>& x, const std::v
   }
   const double b = (n * sxy - sx * sy) / (n * sxx - sx * sx);
   return {(sy - b * sx) / n, b};
+}
+
+// Column under gravity: steps `sim` to t_end and returns the time average of the linear fit
+// σ_zz(z) = a + b z over the particles away from the bottom and top cells (where the discrete
+// stress departs from the line). Each step's fit is weighted by the step that produced it, the
+// last trimmed to end at t_end, so averaging over whole periods removes the oscillation.
+template <int Dim>
+std::array<double, 2> time_averaged_stress_line(Simulation<Dim>& sim, double t_end, double dx,
+                                                double height) {
+  double a_sum = 0.0, b_sum = 0.0, t_sum = 0.0;
+  std::vector<double> z, szz;
+  while (sim.time() < t_end) {
+    sim.step();
+    const double w = std::min(sim.last_dt(), t_end - (sim.time() - sim.last_dt()));
+    const ParticleSnapshot snap = sim.snapshot();
+    z.clear();
+    szz.clear();
+    for (std::size_t i = 0; i < snap.size(); ++i) {
+      if (snap.z[i] < dx || snap.z[i] > height - dx) continue;
+      z.push_back(snap.z[i]);
+      szz.push_back(snap.sigma_zz_pa[i]);
+    }
+    const auto line = fit_line(z, szz);
+    a_sum += w * line[0];
+    b_sum += w * line[1];
+    t_sum += w;
+  }
+  return {a_sum / t_sum, b_sum / t_sum};
 }
 
 }  // namespace crevasse::test

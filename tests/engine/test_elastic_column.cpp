@@ -71,27 +71,9 @@ ColumnResult time_averaged_column(int periods) {
   const double area = Dim == 2 ? kWidth : kWidth3d * kWidth3d;
   ColumnResult r;
   r.weight_per_area = sim.total_mass() * test::kG / area;
-  double a_sum = 0.0, b_sum = 0.0, t_sum = 0.0;
-  std::vector<double> z, szz;
-  while (sim.time() < t_end) {
-    sim.step();
-    // Each sample stands for the step that produced it; the last is trimmed to end at t_end.
-    const double w = std::min(sim.last_dt(), t_end - (sim.time() - sim.last_dt()));
-    const ParticleSnapshot snap = sim.snapshot();
-    z.clear();
-    szz.clear();
-    for (std::size_t i = 0; i < snap.size(); ++i) {
-      if (snap.z[i] < kDx || snap.z[i] > kHeight - kDx) continue;  // boundary cells
-      z.push_back(snap.z[i]);
-      szz.push_back(snap.sigma_zz_pa[i]);
-    }
-    const auto [a, b] = test::fit_line(z, szz);
-    a_sum += w * a;
-    b_sum += w * b;
-    t_sum += w;
-  }
-  r.base_stress = a_sum / t_sum;
-  r.gradient = b_sum / t_sum;
+  const auto [a, b] = test::time_averaged_stress_line(sim, t_end, kDx, kHeight);
+  r.base_stress = a;
+  r.gradient = b;
   return r;
 }
 

@@ -25,23 +25,8 @@ double base_stress_error(double dx) {
   Simulation<2> sim(s);
   const double t_end = 6 * 4.0 * kHeight / s.p_wave_speed();
   const double weight = sim.total_mass() * test::kG / kWidth;
-  double a_sum = 0.0, t_sum = 0.0;
-  std::vector<double> z, szz;
-  while (sim.time() < t_end) {
-    sim.step();
-    const double w = std::min(sim.last_dt(), t_end - (sim.time() - sim.last_dt()));
-    const ParticleSnapshot snap = sim.snapshot();
-    z.clear();
-    szz.clear();
-    for (std::size_t i = 0; i < snap.size(); ++i) {
-      if (snap.z[i] < dx || snap.z[i] > kHeight - dx) continue;
-      z.push_back(snap.z[i]);
-      szz.push_back(snap.sigma_zz_pa[i]);
-    }
-    a_sum += w * test::fit_line(z, szz)[0];
-    t_sum += w;
-  }
-  const double rel = std::abs(-a_sum / t_sum - weight) / weight;
+  const double a = test::time_averaged_stress_line(sim, t_end, dx, kHeight)[0];
+  const double rel = std::abs(-a - weight) / weight;
   std::cout << "dx " << dx << " m: base stress rel. error " << rel << "\n";
   return rel;
 }
