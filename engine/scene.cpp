@@ -219,6 +219,7 @@ void SceneConfig::resolve() {
     if (top_margin == 0.0) top_margin = 0.5 * ice_thickness + 4.0 * dx;
     if (drive_ramp_time == 0.0 && has(Effect::drive)) drive_ramp_time = 100.0 * upstream_length / p_wave_speed();
     check_range("ice.upstream_length", upstream_length, 2.0 * dx, 1e7);
+    check_range("ice.draped_length", draped_length, 0.0, step_length + downstream_length - 4.0 * dx);
     check_range("bed.downstream_length", downstream_length, 4.0 * dx, 1e7);
     check_range("ice.width", width, 2.0 * dx, 1e6);
     check_range("bed.step_height", step_height, 0.0, 1e5);
@@ -279,6 +280,7 @@ SceneConfig scene_from_json(const nlohmann::json& j) {
     o.string("body", s.body);
     o.number("thickness", s.ice_thickness);
     o.number("upstream_length", s.upstream_length);
+    o.number("draped_length", s.draped_length);
     o.number("width", s.width);
     o.vector3("box_min", s.box_min, s.dim);
     o.vector3("box_max", s.box_max, s.dim);
@@ -331,6 +333,7 @@ SceneConfig scene_from_json(const nlohmann::json& j) {
     if (seed < 0) fail("numerics.seed", "must be ≥ 0");
     s.seed = static_cast<std::uint64_t>(seed);
     o.number("top_margin", s.top_margin);
+    o.boolean("volumetric_averaging", s.volumetric_averaging);
     o.refuse_unknown();
   }
   if (const auto* d = r.child("domain")) {
@@ -399,6 +402,7 @@ nlohmann::json scene_to_json(const SceneConfig& s) {
         {"body", s.body},
         {"thickness", s.ice_thickness},
         {"upstream_length", s.upstream_length},
+        {"draped_length", s.draped_length},
         {"width", s.width},
         {"initial_stress", s.initial_stress},
         {"settle_time", s.settle_time},
@@ -424,7 +428,8 @@ nlohmann::json scene_to_json(const SceneConfig& s) {
         {"cfl", s.cfl},
         {"jitter", s.jitter},
         {"seed", s.seed},
-        {"top_margin", s.top_margin}}},
+        {"top_margin", s.top_margin},
+        {"volumetric_averaging", s.volumetric_averaging}}},
       {"run",
        {{"end_time", s.end_time},
         {"front_past_step", s.front_past_step},

@@ -55,6 +55,10 @@ struct SceneConfig {
   std::string body = "slab";          // "slab": glacier on the plateau; "box": box_min..box_max
   double ice_thickness = 100.0;       // H_i [m]
   double upstream_length = 0.0;       // slab length on the plateau [m]; 0 → 5·H_i
+  // Ice already draped over the bed past the top of the step, horizontal length [m]: the
+  // slab continues with its thickness H_i following the bed (surface z_b(x) + H_i). 0: the
+  // slab ends in a cliff at the top of the step (SPEC §2).
+  double draped_length = 0.0;
   double width = 0.0;                 // W_i [m] (3D); 0 → H_i
   std::array<double, 3> box_min{}, box_max{};  // body "box" extent [m]
   std::string initial_stress = "geostatic";    // "geostatic" or "none"
@@ -89,6 +93,10 @@ struct SceneConfig {
   double jitter = 0.0;                // random particle offset, fraction of particle spacing
   std::uint64_t seed = 1;             // jitter seed (study replicas)
   double top_margin = 0.0;            // air above the ice [m]; 0 → 0.5·H_i + 4·dx
+  // ΔJ-bar: each step's volume change is averaged over the grid stencil before the stress
+  // update, which removes the particle-scale pressure checkerboard that quadratic MLS-MPM
+  // builds near concentrated loads (the lip of the step) and that cracks the ice spuriously.
+  bool volumetric_averaging = true;
   std::array<double, 3> domain_min{}, domain_max{};  // body "box": explicit domain [m]
   std::vector<int> wall_axes;         // box_walls: axes with free-slip walls on both faces
   std::vector<VelocityBox> velocity_boxes;

@@ -81,7 +81,16 @@ class Simulation {
   void apply_walls_to_grid(const std::vector<int>& axes, const Vec<Dim>& lo, const Vec<Dim>& hi);
   void apply_velocity_boxes_to_grid();
   template <bool Plastic>
-  void grid_to_particle();
+  void grid_to_particle();  // gather + update fused (no volume averaging)
+  void gather_velocity(std::size_t p);
+  template <bool Plastic>
+  void update_particle(std::size_t p, double volume_scale);
+  void gather_all_velocities();
+  void average_volume_change();
+  template <bool Plastic>
+  void update_all_particles();
+  template <bool Plastic>
+  void finish_step();
   void project_particles_out_of_bed();
   void clamp_particles(int axis, double lo, double hi);
   void remove_outflow();
@@ -105,6 +114,9 @@ class Simulation {
   // P2G colouring: particle indices grouped by x-slab of kSlabCells cells.
   std::vector<std::uint32_t> slab_order_;
   std::vector<std::uint32_t> slab_start_;
+  // Volume averaging scratch (reused every step): per-particle ΔJ̄/ΔJ, per-node averaged ΔJ.
+  std::vector<double> volume_scale_;
+  std::vector<double> grid_aux_;
 
   Vec<Dim> domain_lo_, domain_hi_;
   double time_ = 0.0;

@@ -123,4 +123,18 @@ TEST(Effects, NoGravityNoMotion) {
 }
 
 }  // namespace
+TEST(Effects, VolumeAveragingIsANumericsChoiceWithItsOwnStages) {
+  // Default on: the step gathers velocities, averages ΔJ, then updates the material.
+  Simulation<2> on(block({Effect::plasticity}));
+  EXPECT_TRUE(has_stage(on.stages(), "g2p_velocity"));
+  EXPECT_TRUE(has_stage(on.stages(), "volume_averaging"));
+  EXPECT_TRUE(has_stage(on.stages(), "g2p_return_mapping"));
+  SceneConfig off_scene = block({Effect::plasticity});
+  off_scene.volumetric_averaging = false;
+  Simulation<2> off(off_scene);
+  EXPECT_FALSE(has_stage(off.stages(), "g2p_velocity"));
+  EXPECT_FALSE(has_stage(off.stages(), "volume_averaging"));
+  EXPECT_TRUE(has_stage(off.stages(), "g2p_return_mapping"));
+}
+
 }  // namespace crevasse
