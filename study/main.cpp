@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
+#include <string>
 
 #include "engine/error.hpp"
 #include "study/export_command.hpp"
@@ -10,6 +11,25 @@
 #include "study/run_command.hpp"
 #include "study/status_command.hpp"
 #include "study/study_command.hpp"
+
+namespace {
+
+// The message on one line whatever it quotes from the input (a key with a newline in it).
+std::string one_line(const char* what) {
+  std::string s;
+  for (const char* p = what; *p; ++p) {
+    if (*p == '\n') {
+      s += "\\n";
+    } else if (*p == '\r') {
+      s += "\\r";
+    } else {
+      s += *p;
+    }
+  }
+  return s;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"crevasse: scaling laws of glacier fracture from MPM parameter studies"};
@@ -19,8 +39,8 @@ int main(int argc, char** argv) {
   auto* run = app.add_subcommand("run", "Simulate one scene: VTU snapshots, side-view PNG, crevasse measurement");
   run->add_option("scene", run_opt.scene_path, "Scene JSON file (see README, studies/scenes/)")->required();
   run->add_option("--out", run_opt.out_dir, "Output directory")->required();
-  run->add_option("--vtu-interval", run_opt.vtu_interval, "Simulated seconds between VTU snapshots (overrides the scene)");
-  run->add_option("--threads", run_opt.threads, "Worker threads (default: all cores)");
+  run->add_option("--vtu-interval", run_opt.vtu_interval, "Simulated seconds between VTU snapshots (overrides the scene)")->check(CLI::Range(0.0, 1e9));
+  run->add_option("--threads", run_opt.threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 1024));
   run->add_flag("--quiet", run_opt.quiet, "No progress output");
 
   crevasse::StudyCommandOptions study_opt;
@@ -65,13 +85,13 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   } catch (const crevasse::InputError& e) {
-    std::fprintf(stderr, "crevasse: error: %s\n", e.what());
+    std::fprintf(stderr, "crevasse: error: %s\n", one_line(e.what()).c_str());
     return 2;
   } catch (const crevasse::SimulationError& e) {
-    std::fprintf(stderr, "crevasse: simulation failed: %s\n", e.what());
+    std::fprintf(stderr, "crevasse: simulation failed: %s\n", one_line(e.what()).c_str());
     return 1;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "crevasse: error: %s\n", e.what());
+    std::fprintf(stderr, "crevasse: error: %s\n", one_line(e.what()).c_str());
     return 1;
   }
   return 0;
