@@ -170,6 +170,7 @@ void SceneConfig::resolve() {
          "value " + std::to_string(particles_per_cell_axis) + " is outside the allowed range [1, 6]");
   check_range("numerics.cfl", cfl, 0.0, 2.0, true);
   check_range("numerics.jitter", jitter, 0.0, 0.5);
+  check_range("numerics.top_margin", top_margin, 0.0, 1e6);
   check_range("gravity.g", gravity, 0.0, 1e3);
   check_range("gravity.tilt_deg", gravity_tilt_deg, -90.0, 90.0);
   check_range("drive.speed", drive_speed, 0.0, 1e3);
@@ -253,6 +254,24 @@ void SceneConfig::resolve() {
   for (int a : wall_axes)
     if (a < 0 || a >= dim) fail("domain.wall_axes", "axis " + std::to_string(a) + " is not in [0, dim)");
   if (has(Effect::lateral_walls) && dim != 3) fail("effects", "'lateral_walls' exist in 3D only");
+  for (std::size_t i = 0; i < velocity_boxes.size(); ++i)
+    for (int a = 0; a < dim; ++a)
+      if (!(velocity_boxes[i].max[a] > velocity_boxes[i].min[a]))
+        fail("velocity_boxes[" + std::to_string(i) + "].max", "must exceed min on axis " + std::to_string(a));
+  // Lattice indices are ints and a particle costs about 0.5 kB: refuse what no machine holds.
+  double particles = std::pow(particles_per_cell_axis, dim);
+  for (int a = 0; a < dim; ++a) {
+    if ((domain_max[a] - domain_min[a]) / dx > 1e6)
+      fail("numerics.dx", "value " + fmt(dx) + " gives more than 1e6 cells along axis " + std::to_string(a));
+    const double ice = body == "box" ? box_max[a] - box_min[a]
+                       : a == 0      ? upstream_length + draped_length
+                       : a == dim - 1 ? ice_thickness
+                                      : width;
+    particles *= ice / dx;
+  }
+  if (particles > 1e9)
+    fail("numerics.dx", "value " + fmt(dx) + " gives about " + fmt(particles) +
+                            " particles (limit 1e9); use a coarser dx or a smaller scene");
 }
 
 SceneConfig scene_from_json(const nlohmann::json& j) {
@@ -262,7 +281,7 @@ SceneConfig scene_from_json(const nlohmann::json& j) {
   std::int64_t dim = 2;
   r.integer("dim", dim);
   s.dim = static_cast<int>(dim);
-  if (s.dim != 2 && s.dim != 3) fail("dim", "value " + std::to_string(dim) + " is not 2 or 3");
+  if (dim != 2 && dim != 3) fail("dim", "value " + std::to_string(dim) + " is not 2 or 3");
   if (const auto* e = r.child("effects")) {
     if (!e->is_array()) fail("effects", "must be an array of effect names");
     for (const auto& name : *e) {
@@ -344,7 +363,7 @@ SceneConfig scene_from_json(const nlohmann::json& j) {
       if (!w->is_array()) fail("domain.wall_axes", "must be an array of axis numbers");
       for (const auto& a : *w) {
         if (!a.is_number_integer()) fail("domain.wall_axes", "must contain integers only");
-        s.wall_axes.push_back(a.get<int>());
+        s.wall_axes.push_back(static_cast<int>(std::clamp<std::int64_t>(a.get<std::int64_t>(), -1, 3)));
       }
     }
     o.refuse_unknown();
