@@ -1,0 +1,252 @@
+// The limit kernel of issue 6: only the work no MLS-MPM step can avoid, for the particles of
+// the benchmark scene (bench_scene.hpp, seeded by the engine itself, so the count and order
+// are the same as bench_step's). Per step:
+//  1. clear the grid (a fixed box around the particles, fitted once);
+//  2. P2G: read x, v, C, τ, m, V0 of each particle once and scatter mass and MLS momentum to
+//     its 3^Dim quadratic B-spline nodes (race-free: x-slabs of 4 cells in two colours);
+//  3. grid update: momentum → velocity, plus gravity;
+//  4. G2P: gather v and C from the same nodes, then write x, v, C, F ← (I + Δt C) F and τ once,
+//     with the largest speed reduced on the fly for the next CFL time step.
+// The stress is a linear stand-in (small-strain Hooke's law on F), not a material model: it
+// only makes τ a function of F, written once. The storage layout is the engine's (one array of
+// Eigen fixed-size vectors/matrices per field, double). Counters: particle_steps_per_s and
+// state_B (bytes per particle of the state read and written).
+#include <benchmark/benchmark.h>
+#include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <string>
+#include <vector>
+
+#include "bench/bench_main.hpp"
+#include "bench/bench_scene.hpp"
+#include "engine/bspline.hpp"
+#include "engine/simulation.hpp"
+
+namespace crevasse::bench {
+namespace {
+
+constexpr int kSlabCells = 4;
+constexpr std::size_t kGrain = 1024;
+
+template <int Dim>
+class LimitKernel {
+ public:
+  explicit LimitKernel(const SceneConfig& scene)
+      : dx_(scene.dx),
+        cfl_(scene.cfl),
+        p_wave_speed_(scene.p_wave_speed()),
+        moduli_(ElasticModuli::from_young_poisson(scene.youngs_modulus, scene.poisson_ratio)) {
+    gravity_[up_axis<Dim>] = -scene.gravity;
+    const Simulation<Dim> seeded(scene);
+    const Particles<Dim>& P = seeded.particles();
+    const std::size_t n = P.size();
+    // Sorted by stencil base along x, so that each x-slab of P2G is one contiguous range.
+    std::vector<std::uint32_t> order(n);
+    std::iota(order.begin(), order.end(), 0u);
+    const auto base_x = [&](std::size_t p) {
+      return static_cast<int>(std::floor(P.x[p][0] / dx_ - 0.5));
+    };
+    std::stable_sort(order.begin(), order.end(),
+                     [&](auto a, auto b) { return base_x(a) < base_x(b); });
+    for (std::uint32_t p : order) {
+      x_.push_back(P.x[p]);
+      F_.push_back(P.F_e[p]);
+      tau_.push_back(P.tau[p]);
+      mass_.push_back(P.mass[p]);
+      vol0_.push_back(P.vol0[p]);
+    }
+    v_.assign(n, Vec<Dim>::Zero());
+    C_.assign(n, Mat<Dim>::Zero());
+
+    // Grid box: the particles' stencils plus two cells of room on every side.
+    IVec<Dim> lo = IVec<Dim>::Constant(std::numeric_limits<int>::max());
+    IVec<Dim> hi = IVec<Dim>::Constant(std::numeric_limits<int>::min());
+    for (const auto& x : x_) {
+      for (int a = 0; a < Dim; ++a) {
+        const int b = static_cast<int>(std::floor(x[a] / dx_ - 0.5));
+        lo[a] = std::min(lo[a], b - 2);
+        hi[a] = std::max(hi[a], b + 4);
+      }
+    }
+    grid_lo_ = lo;
+    grid_n_ = (hi - lo).array() + 1;
+    std::size_t nodes = 1;
+    for (int a = 0; a < Dim; ++a) nodes *= static_cast<std::size_t>(grid_n_[a]);
+    grid_mass_.assign(nodes, 0.0);
+    grid_vel_.assign(nodes, Vec<Dim>::Zero());
+
+    // Slab s holds the particles with base_x − lo_x in [4s, 4s + 4): it writes node columns
+    // 4s .. 4s + 5, two columns short of slab s + 2, so a particle may drift almost two cells
+    // during a benchmark before slabs of one colour could share a node.
+    const int slabs = (grid_n_[0] + kSlabCells - 1) / kSlabCells;
+    slab_begin_.assign(static_cast<std::size_t>(slabs) + 1, n);
+    slab_begin_[0] = 0;
+    std::size_t p = 0;
+    for (int s = 1; s <= slabs; ++s) {
+      while (p < n && (base_x_of(x_[p]) - grid_lo_[0]) / kSlabCells < s) ++p;
+      slab_begin_[static_cast<std::size_t>(s)] = p;
+    }
+    dt_ = cfl_ * dx_ / p_wave_speed_;
+  }
+
+  std::size_t size() const { return x_.size(); }
+
+  double state_bytes_per_particle() const {
+    return sizeof(Vec<Dim>) * 2 + sizeof(Mat<Dim>) * 3 + sizeof(double) * 2;
+  }
+
+  void step() {
+    clear_grid();
+    particle_to_grid();
+    grid_update();
+    const double vmax = grid_to_particle();
+    dt_ = cfl_ * dx_ / (p_wave_speed_ + vmax);
+  }
+
+ private:
+  int base_x_of(const Vec<Dim>& x) const { return static_cast<int>(std::floor(x[0] / dx_ - 0.5)); }
+
+  std::size_t flat(const IVec<Dim>& node) const {
+    std::size_t f = 0;
+    for (int a = 0; a < Dim; ++a)
+      f = f * grid_n_[a] + static_cast<std::size_t>(node[a] - grid_lo_[a]);
+    return f;
+  }
+
+  void clear_grid() {
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, grid_mass_.size(), 16 * kGrain), [&](const auto& r) {
+          std::fill(grid_mass_.begin() + r.begin(), grid_mass_.begin() + r.end(), 0.0);
+          std::fill(grid_vel_.begin() + r.begin(), grid_vel_.begin() + r.end(), Vec<Dim>::Zero());
+        });
+  }
+
+  void particle_to_grid() {
+    const double inv_dx = 1.0 / dx_;
+    const double d_inv = 4.0 * inv_dx * inv_dx;
+    const int slabs = static_cast<int>(slab_begin_.size()) - 1;
+    for (int colour = 0; colour < 2; ++colour) {
+      tbb::parallel_for(0, (slabs + 1 - colour) / 2, [&](int half) {
+        const std::size_t s = static_cast<std::size_t>(2 * half + colour);
+        for (std::size_t p = slab_begin_[s]; p < slab_begin_[s + 1]; ++p) {
+          const Vec<Dim> xg = x_[p] * inv_dx;
+          const StencilWeights<Dim> w(xg);
+          const IVec<Dim> base = w.base();
+          const double m = mass_[p];
+          const Mat<Dim> affine = m * C_[p] - (dt_ * d_inv * vol0_[p]) * tau_[p];
+          const Vec<Dim> mv = m * v_[p];
+          for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
+            const IVec<Dim> node = base + off;
+            const Vec<Dim> dpos = (node.template cast<double>() - xg) * dx_;
+            const std::size_t f = flat(node);
+            grid_mass_[f] += wt * m;
+            grid_vel_[f] += wt * (mv + affine * dpos);
+          });
+        }
+      });
+    }
+  }
+
+  void grid_update() {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid_mass_.size(), 16 * kGrain),
+                      [&](const auto& r) {
+                        for (std::size_t f = r.begin(); f != r.end(); ++f) {
+                          if (grid_mass_[f] > 0.0)
+                            grid_vel_[f] = grid_vel_[f] / grid_mass_[f] + dt_ * gravity_;
+                        }
+                      });
+  }
+
+  // Returns the largest particle speed after the update.
+  double grid_to_particle() {
+    const double inv_dx = 1.0 / dx_;
+    const double d_inv = 4.0 * inv_dx * inv_dx;
+    // Linear stand-in for the stress: τ = 2μ ε + λ tr(ε) I, ε = sym(F) − I.
+    const double mu = moduli_.mu, lambda = moduli_.lambda;
+    const double v2 = tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, x_.size(), kGrain), 0.0,
+        [&](const auto& r, double acc) {
+          for (std::size_t p = r.begin(); p != r.end(); ++p) {
+            const Vec<Dim> xg = x_[p] * inv_dx;
+            const StencilWeights<Dim> w(xg);
+            const IVec<Dim> base = w.base();
+            Vec<Dim> v = Vec<Dim>::Zero();
+            Mat<Dim> b = Mat<Dim>::Zero();
+            for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
+              const IVec<Dim> node = base + off;
+              const Vec<Dim> dpos = (node.template cast<double>() - xg) * dx_;
+              const Vec<Dim>& vi = grid_vel_[flat(node)];
+              v += wt * vi;
+              b += wt * vi * dpos.transpose();
+            });
+            const Mat<Dim> c = d_inv * b;
+            const Mat<Dim> f = (Mat<Dim>::Identity() + dt_ * c) * F_[p];
+            const Mat<Dim> eps = 0.5 * (f + f.transpose()) - Mat<Dim>::Identity();
+            x_[p] += dt_ * v;
+            v_[p] = v;
+            C_[p] = c;
+            F_[p] = f;
+            tau_[p] = 2.0 * mu * eps + (lambda * eps.trace()) * Mat<Dim>::Identity();
+            acc = std::max(acc, v.squaredNorm());
+          }
+          return acc;
+        },
+        [](double a, double b) { return std::max(a, b); });
+    return std::sqrt(v2);
+  }
+
+  double dx_, cfl_, p_wave_speed_;
+  ElasticModuli moduli_;
+  double dt_ = 0.0;
+  Vec<Dim> gravity_ = Vec<Dim>::Zero();
+  std::vector<Vec<Dim>> x_, v_;
+  std::vector<Mat<Dim>> C_, F_, tau_;
+  std::vector<double> mass_, vol0_;
+  IVec<Dim> grid_lo_, grid_n_;
+  std::vector<double> grid_mass_;
+  std::vector<Vec<Dim>> grid_vel_;
+  std::vector<std::size_t> slab_begin_;
+};
+
+template <int Dim>
+void limit_benchmark(benchmark::State& state, int threads) {
+  tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism,
+                                  static_cast<std::size_t>(threads));
+  LimitKernel<Dim> kernel(block_scene(Dim, Material::elastic));
+  for (int i = 0; i < kWarmupSteps; ++i) kernel.step();
+  std::int64_t psteps = 0;
+  for (auto _ : state) {
+    kernel.step();
+    psteps += static_cast<std::int64_t>(kernel.size());
+  }
+  auto& c = state.counters;
+  c["particles"] = static_cast<double>(kernel.size());
+  c["particle_steps_per_s"] =
+      benchmark::Counter(static_cast<double>(psteps), benchmark::Counter::kIsRate);
+  c["state_B"] = kernel.state_bytes_per_particle();
+}
+
+void register_all() {
+  for (int dim : {2, 3}) {
+    for (int threads : {1, 2}) {
+      const std::string name =
+          "limit/" + std::to_string(dim) + "d/threads:" + std::to_string(threads);
+      auto* b = dim == 2 ? benchmark::RegisterBenchmark(name.c_str(), limit_benchmark<2>, threads)
+                         : benchmark::RegisterBenchmark(name.c_str(), limit_benchmark<3>, threads);
+      b->Iterations(measured_steps(dim))->UseRealTime()->Unit(benchmark::kMillisecond);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace crevasse::bench
+
+int main(int argc, char** argv) {
+  return crevasse::bench::run_benchmarks(argc, argv, crevasse::bench::register_all);
+}

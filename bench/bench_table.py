@@ -1,0 +1,126 @@
+#!/usr/bin/env python3
+"""Prints the benchmark table of issue 6 from the JSON of bench_step and bench_limit.
+
+Usage: bench_table.py STEP.json LIMIT.json [--stages]
+
+Every number is the median over the repetitions (--benchmark_repetitions); the ± column is the
+standard deviation of the rate over them, relative. Stages are grouped into phases: prepare
+(sort, grid box, P2G colouring), P2G, grid (velocity, gravity, boundary conditions), G2P (gather,
+volume averaging, F update and material) and other (bed projection, clamp, time step).
+--stages prints every stage's ns per particle-step instead of the phase columns.
+"""
+import json
+import sys
+
+PHASES = {
+    "prepare": ["prepare_grid"],
+    "p2g": ["p2g"],
+    "grid": ["grid_velocity", "grid_velocity_gravity", "basal_friction", "box_walls",
+             "lateral_walls", "velocity_boundaries", "settle_damping"],
+    "g2p": ["g2p_velocity", "volume_averaging", "g2p_elastic", "g2p_return_mapping"],
+}
+
+
+def load(path):
+    """{run_name: {aggregate_name: entry}} of a Google Benchmark JSON file."""
+    with open(path) as f:
+        data = json.load(f)
+    runs = {}
+    for b in data["benchmarks"]:
+        if b.get("run_type") != "aggregate":
+            continue
+        name = b["run_name"].split("/iterations:")[0]
+        runs.setdefault(name, {})[b["aggregate_name"]] = b
+    return data.get("context", {}), runs
+
+
+def key_of(name):
+    """('2d', 'softening', 1) for step/2d/softening/threads:1, ('2d', 'limit', 1) for limit."""
+    parts = name.split("/")
+    threads = int(parts[-1].split(":")[1])
+    if parts[0] == "limit":
+        return parts[1], "limit", threads
+    return parts[1], parts[2], threads
+
+
+def phase_ns(entry):
+    out = {p: 0.0 for p in list(PHASES) + ["other"]}
+    for k, v in entry.items():
+        if not k.startswith("ns_"):
+            continue
+        stage = k[3:]
+        phase = next((p for p, names in PHASES.items() if stage in names), "other")
+        out[phase] += v
+    return out
+
+
+def main(argv):
+    if len(argv) < 3:
+        print(__doc__, file=sys.stderr)
+        return 2
+    _, step_runs = load(argv[1])
+    _, limit_runs = load(argv[2])
+    show_stages = "--stages" in argv
+    rows = {}
+    for runs in (step_runs, limit_runs):
+        for name, aggs in runs.items():
+            rows[key_of(name)] = aggs
+    rate = {k: a["median"]["particle_steps_per_s"] for k, a in rows.items()}
+
+    def spread(k):
+        a = rows[k]
+        if "stddev" not in a or rate[k] == 0:
+            return ""
+        return f"{100.0 * a['stddev']['particle_steps_per_s'] / rate[k]:.0f}%"
+
+    order = sorted(rows, key=lambda k: (k[0], k[1] != "limit", k[1], k[2]))
+    if show_stages:
+        stages = sorted({s for k in order for s in rows[k]["median"] if s.startswith("ns_")})
+        print("| stage (ns per particle-step) | " +
+              " | ".join(f"{d} {m} {t}T" for d, m, t in order if m != "limit") + " |")
+        print("|---|" + "---|" * sum(1 for k in order if k[1] != "limit"))
+        for s in stages:
+            cells = []
+            for k in order:
+                if k[1] == "limit":
+                    continue
+                v = rows[k]["median"].get(s)
+                cells.append(f"{v:.1f}" if v is not None else "")
+            print(f"| {s[3:]} | " + " | ".join(cells) + " |")
+        return 0
+
+    header = ["case", "particles", "M pst/s", "±", "of limit", "2T/1T", "particle B", "grid B",
+              "heap B (peak)", "allocs/step", "prep", "p2g", "grid", "g2p", "other"]
+    print("| " + " | ".join(header) + " |")
+    print("|" + "---|" * len(header))
+    for k in order:
+        dim, material, threads = k
+        med = rows[k]["median"]
+        limit = rate.get((dim, "limit", threads))
+        one = rate.get((dim, material, 1))
+        frac = f"{100.0 * rate[k] / limit:.0f}%" if limit else ""
+        speedup = f"{rate[k] / one:.2f}×" if threads > 1 and one else ""
+        if material == "limit":
+            cells = [f"{dim.upper()} limit kernel, {threads} thread{'s' if threads > 1 else ''}",
+                     f"{med['particles']:.0f}", f"{rate[k] / 1e6:.2f}", spread(k), "100%", speedup,
+                     f"{med['state_B']:.0f}", "", "", "", "", "", "", "", ""]
+        else:
+            ph = phase_ns(med)
+            cells = [f"{dim.upper()} {material}, {threads} thread{'s' if threads > 1 else ''}",
+                     f"{med['particles']:.0f}", f"{rate[k] / 1e6:.2f}", spread(k), frac, speedup,
+                     f"{med['particle_B']:.0f}", f"{med['grid_B']:.1f}",
+                     f"{med['heap_B']:.0f} ({med['peak_heap_B']:.0f})",
+                     f"{med['allocs_per_step']:.1f}"] + \
+                    [f"{ph[p]:.0f}" for p in ["prepare", "p2g", "grid", "g2p", "other"]]
+        print("| " + " | ".join(cells) + " |")
+    print()
+    print("M pst/s: million particle-steps per second (wall clock), median; ±: its standard "
+          "deviation over the repetitions. of limit: fraction of the limit kernel at the same "
+          "dimension and thread count. particle B: per-particle arrays of Particles<Dim>; grid B: "
+          "grid mass and velocity; heap B: all heap the simulation holds (peak during a step), "
+          "per particle. prep … other: ns per particle-step of each phase (wall clock).")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
