@@ -157,16 +157,18 @@ Figure regime_diagram(const std::vector<RegimePoint>& points, const RegimeFit& f
     annotations = add_broken_line(figure, *broken, options);
   }
 
-  // Failed cases after all groups, so the legend lists the groups first.
-  std::vector<std::vector<double>> failed_x(groups.size());
+  // Points without a value after all groups, so the legend lists the groups first; one
+  // marker shape per reason, the colour of the point's group.
+  std::vector<std::string> reasons;
+  for (const RegimePoint& p : points) {
+    if (p.failed && std::find(reasons.begin(), reasons.end(), p.missing_reason) == reasons.end())
+      reasons.push_back(p.missing_reason);
+  }
   for (std::size_t g = 0; g < groups.size(); ++g) {
     std::vector<double> x, y, x_bar, lo, hi;
     for (const RegimePoint& p : points) {
       if (p.group != groups[g]) continue;
-      if (p.failed) {
-        failed_x[g].push_back(p.pi);
-        continue;
-      }
+      if (p.failed) continue;
       x.push_back(p.pi);
       y.push_back(p.y);
       if (std::isfinite(p.y_q25) && std::isfinite(p.y_q75)) {
@@ -180,12 +182,22 @@ Figure regime_diagram(const std::vector<RegimePoint>& points, const RegimeFit& f
     figure.add_points(x, y, {palette_marker(g), color, 6.5, true},
                       groups[g].empty() ? "cases" : groups[g]);
   }
-  bool failed_in_legend = false;
-  for (std::size_t g = 0; g < groups.size(); ++g) {
-    if (failed_x[g].empty()) continue;
-    figure.add_bottom_markers(failed_x[g], {MarkerShape::cross, palette_color(g), 6.0, false},
-                              failed_in_legend ? "" : "failed / no crevasse");
-    failed_in_legend = true;
+  constexpr MarkerShape kMissingShapes[] = {MarkerShape::cross, MarkerShape::plus,
+                                            MarkerShape::circle, MarkerShape::square,
+                                            MarkerShape::diamond};
+  for (std::size_t r = 0; r < reasons.size(); ++r) {
+    bool in_legend = false;
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      std::vector<double> x;
+      for (const RegimePoint& p : points) {
+        if (p.failed && p.group == groups[g] && p.missing_reason == reasons[r]) x.push_back(p.pi);
+      }
+      if (x.empty()) continue;
+      figure.add_bottom_markers(
+          x, {kMissingShapes[r % std::size(kMissingShapes)], palette_color(g), 6.0, false},
+          in_legend ? "" : reasons[r]);
+      in_legend = true;
+    }
   }
   add_annotations(figure, annotations, options.legend);
   return figure;

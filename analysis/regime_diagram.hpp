@@ -20,6 +20,9 @@ struct RegimePoint {
   double y_q75 = std::numeric_limits<double>::quiet_NaN();
   std::string group;    // colour/marker group (e.g. "H_i = 200 m")
   bool failed = false;  // no value: drawn as a cross on the bottom edge, never dropped
+  // Why a failed point has no value. Each distinct reason gets its own bottom-edge marker
+  // (cross, plus, then hollow shapes) and legend entry, e.g. "failed" and "no crevasse".
+  std::string missing_reason = "failed / no crevasse";
 };
 
 // No fit, one power law, or a broken line.

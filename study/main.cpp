@@ -3,11 +3,15 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
+#include <optional>
 #include <string>
 
 #include "engine/error.hpp"
+#include "study/calibrate_command.hpp"
 #include "study/export_command.hpp"
+#include "study/fit_command.hpp"
 #include "study/merge.hpp"
+#include "study/plot_command.hpp"
 #include "study/run_command.hpp"
 #include "study/status_command.hpp"
 #include "study/study_command.hpp"
@@ -72,6 +76,49 @@ int main(int argc, char** argv) {
   merge->add_option("out", merge_out, "Output database (created or extended)")->required();
   merge->add_option("inputs", merge_in, "Input databases")->required();
 
+  crevasse::FitCommandOptions fit_opt;
+  auto* fit = app.add_subcommand("fit", "Fit power laws and a broken line to median L_p/H_i and D_p/H_i; store them in the fits table");
+  fit->add_option("db", fit_opt.db_path, "Study database")->required();
+  fit->add_option("--group", fit_opt.groups, "Group on the horizontal axis (repeatable; 'all' = every group that varies; default cohesion_ratio)");
+  fit->add_option("--fixed-exponents", fit_opt.fixed_exponents, "Broken line of L_p/H_i: exponents below,above the breakpoint, each a number or 'free' (e.g. 1,free)");
+  fit->add_option("--fixed-depth-exponents", fit_opt.fixed_depth_exponents, "The same for D_p/H_i");
+  fit->add_option("--level", fit_opt.level, "Confidence level of the intervals (default 0.95)");
+  fit->add_flag("--exclude-fragmented", fit_opt.exclude_fragmented, "Leave out cases flagged fragmented");
+  fit->add_flag("--no-store", fit_opt.no_store, "Print the table only; do not write the fits table");
+
+  crevasse::PlotCommandOptions plot_opt;
+  auto* plot = app.add_subcommand("plot", "Regime diagrams and spacing CDFs of a study as PNG and SVG");
+  plot->add_option("db", plot_opt.db_path, "Study database")->required();
+  plot->add_option("--out", plot_opt.out_dir, "Output directory")->required();
+  plot->add_option("--group", plot_opt.group, "Horizontal axis (default cohesion_ratio)");
+  plot->add_option("--colour-by", plot_opt.colour_by, "Marker colour/shape by this group (default thickness)");
+  plot->add_option("--model", plot_opt.model, "Fit drawn: auto (broken line when warranted), single, broken, none");
+  plot->add_option("--fixed-exponents", plot_opt.fixed_exponents, "As crevasse fit (default: what the fits table used)");
+  plot->add_option("--fixed-depth-exponents", plot_opt.fixed_depth_exponents, "As crevasse fit");
+  plot->add_option("--cdf-cases", plot_opt.cdf_cases, "Case indexes for the spacing CDFs (default: up to 4 spread over the group)")->delimiter(',');
+  plot->add_option("--cdf-normalise", plot_opt.cdf_normalise, "Spacing CDFs normalised by: median (of each case), thickness, none");
+
+  crevasse::CalibrateCommandOptions calibrate_opt;
+  std::optional<double> calibrate_thickness;
+  auto* calibrate = app.add_subcommand("calibrate", "Estimate the tensile strength c from an observed crevasse spacing");
+  calibrate->add_option("--db", calibrate_opt.db_path, "Study database (its fits table, or fits made now)")->required();
+  calibrate->add_option("--spacing", calibrate_opt.spacing_m, "Observed median crevasse spacing L_p [m]")->required();
+  calibrate->add_option("--spacing-quartiles", calibrate_opt.spacing_quartiles, "Observed spacing quartiles Q25,Q75 [m]");
+  calibrate->add_option("--thickness", calibrate_thickness, "Ice thickness H_i at the site [m]");
+  calibrate->add_option("--level", calibrate_opt.level, "Confidence level (default 0.95)");
+
+  crevasse::PredictCommandOptions predict_opt;
+  auto* predict = app.add_subcommand("predict", "Predict crevasse spacing and depth for a tensile strength and thickness");
+  predict->add_option("--db", predict_opt.db_path, "Study database (its fits table, or fits made now)")->required();
+  predict->add_option("--cohesion", predict_opt.tensile_strength_pa, "Tensile strength c [Pa]")->required();
+  predict->add_option("--thickness", predict_opt.thickness_m, "Ice thickness H_i [m]")->required();
+  predict->add_option("--level", predict_opt.level, "Confidence level (default 0.95)");
+
+  // Parse errors on one line, like every other refusal.
+  app.failure_message([](const CLI::App*, const CLI::Error& e) {
+    return std::string("crevasse: error: ") + e.what() + "\n";
+  });
+
   try {
     app.parse(argc, argv);
     if (*run) return crevasse::run_command(run_opt);
@@ -82,6 +129,13 @@ int main(int argc, char** argv) {
     if (*status) return crevasse::status_command(status_opt);
     if (*export_cmd) return crevasse::export_command(export_opt);
     if (*merge) return crevasse::merge_command(merge_out, merge_in);
+    if (*fit) return crevasse::fit_command(fit_opt);
+    if (*plot) return crevasse::plot_command(plot_opt);
+    if (*calibrate) {
+      calibrate_opt.thickness_m = calibrate_thickness;
+      return crevasse::calibrate_command(calibrate_opt);
+    }
+    if (*predict) return crevasse::predict_command(predict_opt);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   } catch (const crevasse::InputError& e) {

@@ -1,0 +1,318 @@
+#include "study/calibrate_command.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <vector>
+
+#include "analysis/calibration.hpp"
+#include "engine/error.hpp"
+#include "study/case_results.hpp"
+#include "study/fits_table.hpp"
+#include "study/store.hpp"
+#include "study/study_fit.hpp"
+
+namespace crevasse {
+namespace {
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
+std::string range(double lo, double hi) {
+  std::string text = "[";
+  text += num(lo);
+  text += ", ";
+  text += num(hi);
+  return text + "]";
+}
+
+// One law of one quantity over a Π range.
+struct QuantityRegime {
+  std::string name;
+  double pi_min = 0.0, pi_max = 0.0;
+  double y_min = 0.0, y_max = 0.0;
+  analysis::PowerLaw law;
+};
+
+// As the calibration library takes it.
+analysis::RegimeLaw spacing_regime(const QuantityRegime& r) {
+  analysis::RegimeLaw regime;
+  regime.name = r.name;
+  regime.pi_min = r.pi_min;
+  regime.pi_max = r.pi_max;
+  regime.spacing_ratio_min = r.y_min;
+  regime.spacing_ratio_max = r.y_max;
+  regime.spacing = r.law;
+  return regime;
+}
+
+// The regimes of one quantity: the broken line's two segments when two regimes are warranted,
+// else the single law. `model` describes the choice.
+struct QuantityLaws {
+  std::vector<QuantityRegime> regimes;
+  std::string model;
+  std::string problem;  // why there is no law
+};
+
+QuantityLaws laws_from_records(const std::vector<FitRecord>& records) {
+  QuantityLaws out;
+  const FitRecord* single = nullptr;
+  const FitRecord* below = nullptr;
+  const FitRecord* above = nullptr;
+  for (const FitRecord& r : records) {
+    if (r.model == "single" && r.ok()) single = &r;
+    if (r.model == "broken" && r.ok() && r.regime == "below") below = &r;
+    if (r.model == "broken" && r.ok() && r.regime == "above") above = &r;
+    if (r.model == "single" && !r.ok()) out.problem = r.note;
+  }
+  if (below && above && below->two_regimes.value_or(false) && below->breakpoint) {
+    const double pi_star = *below->breakpoint;
+    out.model = "two regimes (broken line, Π* = " + num(pi_star) + " " +
+                range(below->breakpoint_lo.value_or(NAN), below->breakpoint_hi.value_or(NAN)) + ")";
+    out.regimes.push_back({"below Π* (Π < " + num(pi_star) + ")", below->x_min.value_or(NAN),
+                           pi_star, below->y_min.value_or(NAN), below->y_max.value_or(NAN),
+                           below->law()});
+    out.regimes.push_back({"above Π* (Π ≥ " + num(pi_star) + ")", pi_star,
+                           above->x_max.value_or(NAN), above->y_min.value_or(NAN),
+                           above->y_max.value_or(NAN), above->law()});
+    return out;
+  }
+  if (single) {
+    out.model =
+        std::string("one regime (single power law; ") +
+        (below && above ? "a second regime is not warranted)" : "too few cases for a broken line)");
+    out.regimes.push_back({"single law", single->x_min.value_or(NAN), single->x_max.value_or(NAN),
+                           single->y_min.value_or(NAN), single->y_max.value_or(NAN),
+                           single->law()});
+  }
+  return out;
+}
+
+struct StudyLaws {
+  std::string title;
+  std::string source;  // where the laws come from
+  QuantityLaws spacing, depth;
+  analysis::IceConstants ice;
+  double thickness_min = 0.0, thickness_max = 0.0;  // H_i the study ran
+};
+
+StudyLaws load_laws(const std::string& db_path) {
+  Store store = Store::open_reader(db_path);
+  const std::vector<CaseRecord> cases = read_case_records(store);
+  StudyLaws laws;
+  laws.title = study_title(store);
+  const FitGroup& pi = find_fit_group("cohesion_ratio", "group");
+  std::vector<FitRecord> spacing = read_fit_records(store, "spacing_over_h", pi.name);
+  std::vector<FitRecord> depth = read_fit_records(store, "depth_over_h", pi.name);
+  if (!spacing.empty()) {
+    laws.source = "laws from the fits table (crevasse fit, " + spacing.front().created_at + ")";
+  } else {
+    laws.source = "no fits table yet: laws fitted now with the defaults (crevasse fit stores them)";
+    spacing = fit_records(fit_study(cases, Quantity::spacing, pi), "");
+    depth = fit_records(fit_study(cases, Quantity::depth, pi), "");
+  }
+  laws.spacing = laws_from_records(spacing);
+  laws.depth = laws_from_records(depth);
+  if (laws.spacing.regimes.empty())
+    throw InputError(db_path + ": the study has no law of L_p/H_i against Π to use: " +
+                     (laws.spacing.problem.empty() ? std::string("run crevasse fit first")
+                                                   : laws.spacing.problem));
+  {
+    // Π = c/(ρ_i g H_i) with the ρ_i and g the study ran with.
+    Statement s(store.handle(),
+                "SELECT json_extract(scene_json, '$.ice.density'), "
+                "json_extract(scene_json, '$.gravity.g'), min(thickness_m), max(thickness_m) "
+                "FROM cases WHERE status = 'done'");
+    if (s.step()) {
+      if (!s.is_null(0)) laws.ice.density_kg_m3 = s.real(0);
+      if (!s.is_null(1)) laws.ice.gravity_m_s2 = s.real(1);
+      laws.thickness_min = s.real(2);
+      laws.thickness_max = s.real(3);
+    }
+  }
+  return laws;
+}
+
+void print_header(const StudyLaws& laws, double level) {
+  std::printf("%s\n  %s; %.0f %% intervals; ρ_i = %s kg/m³, g = %s m/s² as in the study\n",
+              laws.title.c_str(), laws.source.c_str(), 100.0 * level,
+              num(laws.ice.density_kg_m3).c_str(), num(laws.ice.gravity_m_s2).c_str());
+  std::printf("  L_p/H_i: %s\n", laws.spacing.model.c_str());
+}
+
+std::string law_text(const char* symbol, const QuantityRegime& r) {
+  return std::string(symbol) + " = " + num(r.law.a()) + " Π^" + num(r.law.b) + " on Π in " +
+         range(r.pi_min, r.pi_max) + ", " + symbol + " in " + range(r.y_min, r.y_max);
+}
+
+void note_thickness(const StudyLaws& laws, double h) {
+  if (h < laws.thickness_min * (1 - 1e-9) || h > laws.thickness_max * (1 + 1e-9))
+    std::printf(
+        "  note: H_i = %s m is outside the thicknesses the study ran (%s to %s m); the "
+        "law is used through Π and L_p/H_i alone\n",
+        num(h).c_str(), num(laws.thickness_min).c_str(), num(laws.thickness_max).c_str());
+}
+
+double positive(double v, const std::string& option) {
+  if (!std::isfinite(v) || v <= 0.0)
+    throw InputError(option + ": must be a positive number, got " + num(v));
+  return v;
+}
+
+}  // namespace
+
+int calibrate_command(const CalibrateCommandOptions& opt) {
+  if (!(opt.level > 0.5 && opt.level < 1.0))
+    throw InputError("--level: " + num(opt.level) + " is outside (0.5, 1)");
+  analysis::SpacingObservation obs;
+  obs.spacing_m = positive(opt.spacing_m, "--spacing");
+  if (opt.thickness_m) obs.thickness_m = positive(*opt.thickness_m, "--thickness");
+  if (!opt.spacing_quartiles.empty()) {
+    const auto comma = opt.spacing_quartiles.find(',');
+    double q25 = NAN, q75 = NAN;
+    try {
+      std::size_t used1 = 0, used2 = 0;
+      const std::string a = opt.spacing_quartiles.substr(0, comma);
+      const std::string b =
+          comma == std::string::npos ? "" : opt.spacing_quartiles.substr(comma + 1);
+      q25 = std::stod(a, &used1);
+      q75 = std::stod(b, &used2);
+      if (used1 != a.size() || used2 != b.size()) q25 = NAN;
+    } catch (const std::exception&) {
+      q25 = NAN;
+    }
+    if (!std::isfinite(q25) || !std::isfinite(q75))
+      throw InputError("--spacing-quartiles: expected Q25,Q75 in metres, got '" +
+                       opt.spacing_quartiles + "'");
+    if (!(q25 > 0.0 && q25 <= obs.spacing_m && obs.spacing_m <= q75))
+      throw InputError("--spacing-quartiles: need 0 < Q25 <= spacing <= Q75, got " + num(q25) +
+                       " <= " + num(obs.spacing_m) + " <= " + num(q75));
+    obs.spacing_q25_m = q25;
+    obs.spacing_q75_m = q75;
+  }
+
+  const StudyLaws laws = load_laws(opt.db_path);
+  analysis::CalibrationOptions options;
+  options.ice = laws.ice;
+  options.level = opt.level;
+
+  // Each regime's answer, or why it refused.
+  struct Answer {
+    std::optional<analysis::CohesionEstimate> estimate;
+    std::string refusal;
+  };
+  std::vector<Answer> answers;
+  for (const QuantityRegime& r : laws.spacing.regimes) {
+    const analysis::RegimeLaw regime = spacing_regime(r);
+    Answer a;
+    try {
+      a.estimate = analysis::invert_spacing_for_cohesion(regime, obs, options);
+    } catch (const std::out_of_range& e) {
+      a.refusal = e.what();
+    } catch (const std::domain_error& e) {
+      a.refusal = e.what();
+    } catch (const std::invalid_argument& e) {
+      throw InputError(std::string("--spacing: ") + e.what());
+    }
+    answers.push_back(std::move(a));
+  }
+  if (std::none_of(answers.begin(), answers.end(), [](const Answer& a) { return a.estimate; })) {
+    std::string all;
+    for (const Answer& a : answers) all += (all.empty() ? "" : "; ") + a.refusal;
+    throw InputError("--spacing: no regime of the study can invert this observation: " + all);
+  }
+
+  print_header(laws, opt.level);
+  std::printf("observation: median spacing L_p = %s m", num(obs.spacing_m).c_str());
+  if (obs.spacing_q25_m)
+    std::printf(", quartiles %s m", range(*obs.spacing_q25_m, *obs.spacing_q75_m).c_str());
+  if (obs.thickness_m)
+    std::printf(", H_i = %s m (L_p/H_i = %s)", num(*obs.thickness_m).c_str(),
+                num(obs.spacing_m / *obs.thickness_m).c_str());
+  else
+    std::printf(", thickness not given");
+  std::printf("\n");
+  for (std::size_t k = 0; k < answers.size(); ++k) {
+    const QuantityRegime& r = laws.spacing.regimes[k];
+    std::printf("\nregime %s: %s\n", r.name.c_str(), law_text("L_p/H_i", r).c_str());
+    if (!answers[k].estimate) {
+      std::printf("  refused: %s\n", answers[k].refusal.c_str());
+      continue;
+    }
+    const analysis::CohesionEstimate& e = *answers[k].estimate;
+    std::printf("  tensile strength c = %s Pa, %.0f %% interval %s Pa\n",
+                num(e.tensile_strength_pa).c_str(), 100.0 * e.level,
+                range(e.interval_pa.lower, e.interval_pa.upper).c_str());
+    if (e.cohesion_ratio_pi) {
+      const bool in = e.pi_in_regime_range.value_or(false);
+      std::printf(
+          "  Π = %s %s: %s this regime's Π range %s%s\n", num(e.cohesion_ratio_pi->value).c_str(),
+          range(e.cohesion_ratio_pi->interval.lower, e.cohesion_ratio_pi->interval.upper).c_str(),
+          in ? "inside" : "OUTSIDE", range(r.pi_min, r.pi_max).c_str(),
+          in ? (e.pi_interval_in_regime_range.value_or(false)
+                    ? " (whole interval inside): the thickness puts the site in this "
+                      "regime"
+                    : " (the interval reaches outside it)")
+             : ": the thickness does not put the site in this regime; this answer is "
+               "not self-consistent");
+    } else {
+      std::printf("  without H_i it cannot be checked that the site is in this regime\n");
+    }
+    for (const std::string& n : e.notes) std::printf("  - %s\n", n.c_str());
+  }
+  if (obs.thickness_m) note_thickness(laws, *obs.thickness_m);
+  return 0;
+}
+
+int predict_command(const PredictCommandOptions& opt) {
+  if (!(opt.level > 0.5 && opt.level < 1.0))
+    throw InputError("--level: " + num(opt.level) + " is outside (0.5, 1)");
+  positive(opt.tensile_strength_pa, "--cohesion");
+  positive(opt.thickness_m, "--thickness");
+  const StudyLaws laws = load_laws(opt.db_path);
+  const double pi = analysis::cohesion_ratio(opt.tensile_strength_pa, opt.thickness_m, laws.ice);
+  const auto holds = [&](const QuantityRegime& r) { return r.pi_min <= pi && pi <= r.pi_max; };
+  const auto& spacing = laws.spacing.regimes;
+  const auto s = std::find_if(spacing.begin(), spacing.end(), holds);
+  if (s == spacing.end())
+    throw InputError("--cohesion/--thickness: Π = c/(ρ_i g H_i) = " + num(pi) +
+                     " lies outside the Π range the study covered, " +
+                     range(spacing.front().pi_min, spacing.back().pi_max) +
+                     "; the laws are not extrapolated");
+  analysis::RegimeLaw regime = spacing_regime(*s);
+  const auto& depth = laws.depth.regimes;
+  const auto d = std::find_if(depth.begin(), depth.end(), holds);
+  if (d != depth.end()) regime.depth = d->law;
+  analysis::CalibrationOptions options;
+  options.ice = laws.ice;
+  options.level = opt.level;
+  const analysis::CrevassePrediction p =
+      analysis::predict_crevasses(regime, opt.tensile_strength_pa, opt.thickness_m, options);
+
+  print_header(laws, opt.level);
+  std::printf("c = %s Pa, H_i = %s m: Π = %s, regime %s\n", num(opt.tensile_strength_pa).c_str(),
+              num(opt.thickness_m).c_str(), num(pi).c_str(), s->name.c_str());
+  std::printf("  %s\n", law_text("L_p/H_i", *s).c_str());
+  std::printf("  median spacing L_p = %s m: the law's %.0f %% band %s m, one site %s m\n",
+              num(p.spacing_m.value).c_str(), 100.0 * opt.level,
+              range(p.spacing_m.interval.lower, p.spacing_m.interval.upper).c_str(),
+              range(p.spacing_prediction_m.lower, p.spacing_prediction_m.upper).c_str());
+  if (p.depth_m) {
+    std::printf("  %s\n", law_text("D_p/H_i", *d).c_str());
+    std::printf("  median depth D_p = %s m: the law's %.0f %% band %s m, one site %s m\n",
+                num(p.depth_m->value).c_str(), 100.0 * opt.level,
+                range(p.depth_m->interval.lower, p.depth_m->interval.upper).c_str(),
+                range(p.depth_prediction_m->lower, p.depth_prediction_m->upper).c_str());
+  } else {
+    std::printf("  depth: no law of D_p/H_i covers Π = %s (%s)\n", num(pi).c_str(),
+                depth.empty() ? laws.depth.problem.c_str() : "outside its Π range");
+  }
+  note_thickness(laws, opt.thickness_m);
+  return 0;
+}
+
+}  // namespace crevasse

@@ -1,0 +1,31 @@
+#pragma once
+// `crevasse calibrate` and `crevasse predict` (SPEC §6, docs/fits.md §5): the study's laws of
+// L_p/H_i (and D_p/H_i) against Π = c/(ρ_i g H_i), inverted to estimate the tensile strength c
+// from an observed crevasse spacing, or used forwards to predict spacing and depth for a given c
+// and H_i. The laws are the rows of the database's `fits` table (crevasse fit); when the table
+// has none, the same fits are computed in memory with the defaults. No extrapolation: an
+// observation outside what the study covered is refused (exit 2).
+#include <optional>
+#include <string>
+
+namespace crevasse {
+
+struct CalibrateCommandOptions {
+  std::string db_path;
+  double spacing_m = 0.0;
+  std::string spacing_quartiles;  // "q25,q75" [m], or empty
+  std::optional<double> thickness_m;
+  double level = 0.95;
+};
+
+struct PredictCommandOptions {
+  std::string db_path;
+  double tensile_strength_pa = 0.0;
+  double thickness_m = 0.0;
+  double level = 0.95;
+};
+
+int calibrate_command(const CalibrateCommandOptions& opt);
+int predict_command(const PredictCommandOptions& opt);
+
+}  // namespace crevasse

@@ -1,0 +1,105 @@
+#include "study/case_results.hpp"
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "engine/error.hpp"
+
+namespace crevasse {
+
+const FitGroup& find_fit_group(const std::string& name, const std::string& option) {
+  for (const FitGroup& g : kFitGroups)
+    if (name == g.name) return g;
+  throw InputError(option + ": unknown group '" + name + "'; allowed: " + fit_group_names());
+}
+
+std::string fit_group_names() {
+  std::string names;
+  for (const FitGroup& g : kFitGroups) names += (names.empty() ? "" : ", ") + std::string(g.name);
+  return names;
+}
+
+const char* quantity_key(Quantity q) {
+  return q == Quantity::spacing ? "spacing_over_h" : "depth_over_h";
+}
+const char* quantity_symbol(Quantity q) { return q == Quantity::spacing ? "L_p/H_i" : "D_p/H_i"; }
+
+std::optional<double> CaseRecord::group(const FitGroup& g) const {
+  for (std::size_t i = 0; i < std::size(kFitGroups); ++i)
+    if (std::string(kFitGroups[i].name) == g.name) return groups[i];
+  return std::nullopt;
+}
+
+std::optional<double> CaseRecord::median(Quantity q) const {
+  const std::optional<double> m = quartiles(q)[1];
+  if (!m || !std::isfinite(*m) || *m <= 0.0) return std::nullopt;
+  return m;
+}
+
+std::string CaseRecord::missing_reason(Quantity q) const {
+  if (median(q)) return {};
+  if (status == "failed") return "failed";
+  if (status != "done") return "not run yet";
+  if (!has_summary || no_crevasse || crevasse_count == 0) return "no crevasse";
+  if (quartiles(q)[1]) return "non-positive value";
+  if (q == Quantity::spacing && crevasse_count < 2) return "fewer than 2 crevasses";
+  if (q == Quantity::spacing) return "no spacing above the resolution floor";
+  return "no value";
+}
+
+std::vector<CaseRecord> read_case_records(Store& store) {
+  sqlite3* db = store.handle();
+  const std::string where = store.path().string();
+  {
+    Statement s(db, "SELECT count(*) FROM study");
+    s.step();
+    if (s.integer(0) == 0)
+      throw InputError(where + ": the database holds no study yet; run crevasse study first");
+  }
+  std::string columns;
+  for (const FitGroup& g : kFitGroups) columns += "c." + std::string(g.column) + ", ";
+  Statement s(
+      db, "SELECT c.case_id, c.case_index, c.label, c.status, coalesce(c.failure_reason, ''), " +
+              columns +
+              "m.case_id IS NOT NULL, m.crevasse_count, m.spacing_count, m.no_crevasse, "
+              "m.fragmented, m.spacing_q25_over_h, m.spacing_median_over_h, "
+              "m.spacing_q75_over_h, m.depth_q25_over_h, m.depth_median_over_h, "
+              "m.depth_q75_over_h, m.spacings_json "
+              "FROM cases c LEFT JOIN summaries m USING (case_id) ORDER BY c.case_index, "
+              "c.replica, c.case_id");
+  std::vector<CaseRecord> out;
+  while (s.step()) {
+    CaseRecord r;
+    int k = 0;
+    r.case_id = s.text(k++);
+    r.case_index = s.integer(k++);
+    r.label = s.text(k++);
+    r.status = s.text(k++);
+    r.failure_reason = s.text(k++);
+    for (auto& g : r.groups) g = s.optional_real(k++);
+    r.has_summary = s.integer(k++) != 0;
+    r.crevasse_count = s.integer(k++);
+    r.spacing_count = s.integer(k++);
+    r.no_crevasse = s.integer(k++) != 0;
+    r.fragmented = s.integer(k++) != 0;
+    for (auto& q : r.spacing_over_h) q = s.optional_real(k++);
+    for (auto& q : r.depth_over_h) q = s.optional_real(k++);
+    if (!s.is_null(k)) {
+      const auto j = nlohmann::json::parse(s.text(k), nullptr, false);
+      if (j.is_array())
+        for (const auto& v : j)
+          if (v.is_number()) r.spacings_m.push_back(v.get<double>());
+    }
+    out.push_back(std::move(r));
+  }
+  if (out.empty()) throw InputError(where + ": the study has no cases");
+  return out;
+}
+
+std::string study_title(Store& store) {
+  Statement s(store.handle(), "SELECT name FROM study WHERE id = 1");
+  const std::string name = s.step() ? s.text(0) : std::string("?");
+  return "study '" + name + "' (" + store.path().string() + ")";
+}
+
+}  // namespace crevasse

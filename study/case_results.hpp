@@ -1,0 +1,81 @@
+#pragma once
+// The per-case results of a study database as the analysis reads them (SPEC §6): each case's
+// groups (SPEC §1), status, the quartiles of L_p/H_i and D_p/H_i, its spacings, and why a case
+// has no value when it has none. Shared by `crevasse fit`, `plot`, `calibrate` and `predict`.
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "study/store.hpp"
+
+namespace crevasse {
+
+// A dimensionless group (or H_i) that a fit or figure can put on its horizontal axis.
+struct FitGroup {
+  const char* name;    // as on the command line and in the fits table: "cohesion_ratio"
+  const char* column;  // column of the cases table
+  const char* symbol;  // figure/table markup: "Π"
+  const char* axis_label;
+};
+
+inline constexpr FitGroup kFitGroups[] = {
+    {"cohesion_ratio", "cohesion_ratio", "Π", "Π = c/(ρ_i g H_i)"},
+    {"thickness", "thickness_m", "H_i", "H_i [m]"},
+    {"step_length_ratio", "step_length_ratio", "r", "r = L_s/H_i"},
+    {"step_height_ratio", "step_height_ratio", "h", "h = H_s/H_i"},
+    {"slope", "slope", "S", "S = H_s/L_s"},
+    {"width_ratio", "width_ratio", "w", "w = W_i/H_i"},
+};
+
+// The group called `name`; throws InputError naming `option` and the allowed names.
+const FitGroup& find_fit_group(const std::string& name, const std::string& option);
+// "cohesion_ratio, thickness, ...".
+std::string fit_group_names();
+
+// The responses fitted against a group: median L_p/H_i and median D_p/H_i per case.
+enum class Quantity { spacing, depth };
+inline constexpr Quantity kQuantities[] = {Quantity::spacing, Quantity::depth};
+const char* quantity_key(Quantity q);     // "spacing_over_h", "depth_over_h" (fits table)
+const char* quantity_symbol(Quantity q);  // "L_p/H_i", "D_p/H_i"
+
+struct CaseRecord {
+  std::string case_id;
+  std::int64_t case_index = 0;
+  std::string label;
+  std::string status;  // pending, running, done, failed
+  std::string failure_reason;
+  // Group values in the order of kFitGroups; empty where the group does not apply (slope of a
+  // vertical step, width in 2D).
+  std::array<std::optional<double>, std::size(kFitGroups)> groups;
+  bool has_summary = false;  // done cases with a measurement
+  std::int64_t crevasse_count = 0;
+  std::int64_t spacing_count = 0;
+  bool no_crevasse = false;
+  bool fragmented = false;
+  // q25, median, q75 of L_p/H_i and of D_p/H_i (empty when nothing was measured).
+  std::array<std::optional<double>, 3> spacing_over_h, depth_over_h;
+  std::vector<double> spacings_m;  // every spacing kept [m]
+
+  double thickness_m() const { return groups[1].value_or(0.0); }
+  double cohesion_ratio() const { return groups[0].value_or(0.0); }
+  std::optional<double> group(const FitGroup& g) const;
+  const std::array<std::optional<double>, 3>& quartiles(Quantity q) const {
+    return q == Quantity::spacing ? spacing_over_h : depth_over_h;
+  }
+  // The median of `q`, present only when it is finite and positive (fit- and log-axis-ready).
+  std::optional<double> median(Quantity q) const;
+  // Why median(q) is empty: "failed", "not run yet", "no crevasse", "fewer than 2 crevasses",
+  // "no spacing above the resolution floor", "non-positive value". Empty when it has a value.
+  std::string missing_reason(Quantity q) const;
+};
+
+// Every case of the database, by case_index. Throws InputError when the database holds no
+// study or no cases.
+std::vector<CaseRecord> read_case_records(Store& store);
+
+// "study 'quick' (results/quick.db)".
+std::string study_title(Store& store);
+
+}  // namespace crevasse

@@ -1,0 +1,249 @@
+#include "study/plot_command.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include "analysis/regime_diagram.hpp"
+#include "engine/error.hpp"
+#include "study/case_results.hpp"
+#include "study/fits_table.hpp"
+#include "study/store.hpp"
+#include "study/study_fit.hpp"
+
+namespace crevasse {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
+std::string group_value_label(const FitGroup& g, const std::optional<double>& v) {
+  if (!v) return std::string(g.symbol) + " n/a";
+  if (std::string(g.name) == "thickness") return "H_i = " + num(*v) + " m";
+  return std::string(g.symbol) + " = " + num(*v);
+}
+
+// The fixed exponents given on the command line, else those the fits table was made with.
+StudyFitOptions fit_options(Store& store, Quantity q, const FitGroup& group,
+                            const std::string& given, const std::string& option) {
+  StudyFitOptions options;
+  if (!given.empty()) {
+    parse_fixed_exponents(given, option, options);
+    return options;
+  }
+  for (const FitRecord& r : read_fit_records(store, quantity_key(q), group.name)) {
+    if (!r.fixed_exponents.empty()) {
+      parse_fixed_exponents(r.fixed_exponents, "fits table", options);
+      break;
+    }
+  }
+  return options;
+}
+
+analysis::RegimeFit chosen_fit(const StudyFit& fit, const std::string& model) {
+  if (model == "none") return {};
+  if (model == "broken" || (model == "auto" && fit.two_regimes())) {
+    if (fit.broken) return *fit.broken;
+    if (model == "broken") return {};
+  }
+  if (fit.single) return *fit.single;
+  return {};
+}
+
+std::string fit_summary(const analysis::RegimeFit& fit, const StudyFit& study_fit) {
+  if (std::holds_alternative<analysis::BrokenLineFit>(fit)) return "broken line";
+  if (std::holds_alternative<analysis::PowerLawFit>(fit)) return "single power law";
+  return "no fit (" +
+         (study_fit.single_problem.empty() ? std::string("--model none")
+                                           : study_fit.single_problem) +
+         ")";
+}
+
+std::vector<fs::path> write_figure(const analysis::Figure& figure, const fs::path& stem) {
+  const fs::path png = stem.string() + ".png", svg = stem.string() + ".svg";
+  figure.write_png(png.string());
+  figure.write_svg(svg.string());
+  return {png, svg};
+}
+
+// Up to four cases with spacings, spread evenly over the group's range.
+std::vector<const CaseRecord*> default_cdf_cases(const std::vector<CaseRecord>& cases,
+                                                 const FitGroup& group) {
+  std::vector<const CaseRecord*> eligible;
+  for (const CaseRecord& c : cases)
+    if (!c.spacings_m.empty()) eligible.push_back(&c);
+  std::stable_sort(eligible.begin(), eligible.end(), [&](const CaseRecord* a, const CaseRecord* b) {
+    return a->group(group).value_or(0.0) < b->group(group).value_or(0.0);
+  });
+  constexpr std::size_t kMax = 4;
+  if (eligible.size() <= kMax) return eligible;
+  std::vector<const CaseRecord*> chosen;
+  for (std::size_t i = 0; i < kMax; ++i)
+    chosen.push_back(eligible[(i * (eligible.size() - 1) + (kMax - 1) / 2) / (kMax - 1)]);
+  return chosen;
+}
+
+}  // namespace
+
+std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
+  const FitGroup& group = find_fit_group(opt.group, "--group");
+  const FitGroup& colour_by = find_fit_group(opt.colour_by, "--colour-by");
+  if (opt.model != "auto" && opt.model != "single" && opt.model != "broken" && opt.model != "none")
+    throw InputError("--model: '" + opt.model + "' is not one of auto, single, broken, none");
+  if (opt.cdf_normalise != "median" && opt.cdf_normalise != "thickness" &&
+      opt.cdf_normalise != "none")
+    throw InputError("--cdf-normalise: '" + opt.cdf_normalise +
+                     "' is not one of median, thickness, none");
+
+  Store store = Store::open_reader(opt.db_path);
+  const std::vector<CaseRecord> cases = read_case_records(store);
+  std::string study_name;
+  {
+    Statement s(store.handle(), "SELECT name FROM study WHERE id = 1");
+    study_name = s.step() ? s.text(0) : "study";
+  }
+  std::vector<const CaseRecord*> cdf_cases;
+  for (std::int64_t index : opt.cdf_cases) {
+    const auto it = std::find_if(cases.begin(), cases.end(),
+                                 [&](const CaseRecord& c) { return c.case_index == index; });
+    if (it == cases.end())
+      throw InputError("--cdf-cases: no case with index " + std::to_string(index) + " in " +
+                       opt.db_path + " (crevasse status " + opt.db_path + " --all lists them)");
+    if (it->spacings_m.empty())
+      throw InputError("--cdf-cases: case " + std::to_string(index) + " (" + it->label +
+                       ") has no spacings (" + it->missing_reason(Quantity::spacing) + ")");
+    cdf_cases.push_back(&*it);
+  }
+
+  std::error_code ec;
+  fs::create_directories(opt.out_dir, ec);
+  if (ec || !fs::is_directory(opt.out_dir))
+    throw InputError("--out: cannot create directory " + opt.out_dir +
+                     (ec ? " (" + ec.message() + ")" : ""));
+
+  std::vector<fs::path> written;
+  for (Quantity q : kQuantities) {
+    const std::string option =
+        q == Quantity::spacing ? "--fixed-exponents" : "--fixed-depth-exponents";
+    const StudyFit fit = fit_study(
+        cases, q, group,
+        fit_options(store, q, group,
+                    q == Quantity::spacing ? opt.fixed_exponents : opt.fixed_depth_exponents,
+                    option));
+    std::vector<std::pair<double, analysis::RegimePoint>> keyed;  // colour group value, point
+    std::map<std::string, std::size_t> missing;
+    std::size_t skipped = 0;
+    for (const CaseRecord& c : cases) {
+      const std::optional<double> x = c.group(group);
+      if (c.status == "pending" || c.status == "running" || !x || !(*x > 0.0)) {
+        ++skipped;
+        continue;
+      }
+      analysis::RegimePoint p;
+      p.pi = *x;
+      p.group = group_value_label(colour_by, c.group(colour_by));
+      if (const auto y = c.median(q)) {
+        p.y = *y;
+        const auto& quartiles = c.quartiles(q);
+        if (quartiles[0] && quartiles[2] && *quartiles[0] > 0.0) {
+          p.y_q25 = *quartiles[0];
+          p.y_q75 = *quartiles[2];
+        }
+      } else {
+        p.failed = true;
+        p.missing_reason = c.missing_reason(q);
+        ++missing[p.missing_reason];
+      }
+      keyed.emplace_back(c.group(colour_by).value_or(HUGE_VAL), p);
+    }
+    // Colours follow the colour group's numeric order.
+    std::stable_sort(keyed.begin(), keyed.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::vector<analysis::RegimePoint> points;
+    for (auto& [key, p] : keyed) points.push_back(std::move(p));
+    if (points.empty())
+      throw InputError(opt.db_path + ": no finished case has a positive " + group.name +
+                       "; nothing to plot");
+
+    const analysis::RegimeFit drawn = chosen_fit(fit, opt.model);
+    analysis::RegimeDiagramOptions options;
+    const std::size_t measured = points.size() - [&] {
+      std::size_t n = 0;
+      for (const auto& [reason, k] : missing) n += k;
+      return n;
+    }();
+    options.title = study_name + ": median " +
+                    (q == Quantity::spacing ? std::string("spacing") : std::string("depth")) +
+                    ", " + std::to_string(measured) + " of " + std::to_string(points.size()) +
+                    " cases measured";
+    options.y_label = quantity_symbol(q);
+    options.x_label = group.axis_label;
+    options.x_symbol = group.symbol;
+    const analysis::Figure figure = analysis::regime_diagram(points, drawn, options);
+    const std::string stem =
+        std::string(q == Quantity::spacing ? "spacing" : "depth") + "_vs_" + group.name;
+    const auto files = write_figure(figure, fs::path(opt.out_dir) / stem);
+    written.insert(written.end(), files.begin(), files.end());
+    std::string missing_text;
+    for (const auto& [reason, k] : missing)
+      missing_text += (missing_text.empty() ? "" : ", ") + std::to_string(k) + " " + reason;
+    std::printf(
+        "%s: %zu case(s) drawn (%s), fit: %s%s\n", files.front().c_str(), points.size(),
+        missing_text.empty() ? "all measured" : ("no value: " + missing_text).c_str(),
+        fit_summary(drawn, fit).c_str(),
+        skipped ? (", " + std::to_string(skipped) + " not drawn (not run yet)").c_str() : "");
+  }
+
+  if (cdf_cases.empty() && opt.cdf_cases.empty()) cdf_cases = default_cdf_cases(cases, group);
+  if (cdf_cases.empty()) {
+    std::printf("no case has a crevasse spacing: spacing CDF figure not drawn\n");
+    return written;
+  }
+  std::vector<analysis::NamedSample> samples;
+  for (const CaseRecord* c : cdf_cases) {
+    analysis::NamedSample sample;
+    sample.name = "#" + std::to_string(c->case_index) + " " +
+                  group_value_label(group, c->group(group)) +
+                  (std::string(group.name) == "thickness"
+                       ? ""
+                       : ", " + group_value_label(kFitGroups[1], c->group(kFitGroups[1])));
+    std::vector<double> v = c->spacings_m;
+    double scale = 1.0;
+    if (opt.cdf_normalise == "thickness") scale = c->thickness_m();
+    if (opt.cdf_normalise == "median") {
+      std::vector<double> sorted = v;
+      std::sort(sorted.begin(), sorted.end());
+      const std::size_t n = sorted.size();
+      scale = n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
+    }
+    for (double& x : v) x /= scale;
+    sample.values = std::move(v);
+    samples.push_back(std::move(sample));
+  }
+  analysis::CdfFigureOptions cdf;
+  cdf.title = study_name + ": crevasse spacings of " + std::to_string(samples.size()) + " case(s)";
+  cdf.x_label = opt.cdf_normalise == "median"      ? "L_p / median L_p of the case"
+                : opt.cdf_normalise == "thickness" ? "L_p/H_i"
+                                                   : "L_p [m]";
+  const auto files = write_figure(analysis::empirical_cdf_figure(samples, cdf),
+                                  fs::path(opt.out_dir) / "spacing_cdf");
+  written.insert(written.end(), files.begin(), files.end());
+  std::printf("%s: spacing CDFs of case(s)", files.front().c_str());
+  for (const CaseRecord* c : cdf_cases) std::printf(" %lld", static_cast<long long>(c->case_index));
+  std::printf(", normalised by %s\n", opt.cdf_normalise.c_str());
+  return written;
+}
+
+int plot_command(const PlotCommandOptions& opt) {
+  const auto files = plot_study(opt);
+  std::printf("wrote %zu file(s) to %s\n", files.size(), opt.out_dir.c_str());
+  return 0;
+}
+
+}  // namespace crevasse
