@@ -18,6 +18,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 #include <string>
@@ -78,8 +79,9 @@ class LimitKernel {
     grid_n_ = (hi - lo).array() + 1;
     std::size_t nodes = 1;
     for (int a = 0; a < Dim; ++a) nodes *= static_cast<std::size_t>(grid_n_[a]);
-    grid_mass_.assign(nodes, 0.0);
-    grid_vel_.assign(nodes, Vec<Dim>::Zero());
+    grid_.assign(nodes, Node::Zero());
+    for (int a = Dim - 1; a >= 0; --a)
+      stride_[a] = a == Dim - 1 ? 1 : stride_[a + 1] * static_cast<std::size_t>(grid_n_[a + 1]);
 
     // Slab s holds the particles with base_x − lo_x in [4s, 4s + 4): it writes node columns
     // 4s .. 4s + 5, two columns short of slab s + 2, so a particle may drift almost two cells
@@ -114,17 +116,15 @@ class LimitKernel {
 
   std::size_t flat(const IVec<Dim>& node) const {
     std::size_t f = 0;
-    for (int a = 0; a < Dim; ++a)
-      f = f * grid_n_[a] + static_cast<std::size_t>(node[a] - grid_lo_[a]);
+    for (int a = 0; a < Dim; ++a) f += static_cast<std::size_t>(node[a] - grid_lo_[a]) * stride_[a];
     return f;
   }
 
   void clear_grid() {
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, grid_mass_.size(), 16 * kGrain), [&](const auto& r) {
-          std::fill(grid_mass_.begin() + r.begin(), grid_mass_.begin() + r.end(), 0.0);
-          std::fill(grid_vel_.begin() + r.begin(), grid_vel_.begin() + r.end(), Vec<Dim>::Zero());
-        });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid_.size(), 16 * kGrain),
+                      [&](const auto& r) {
+                        std::fill(grid_.begin() + r.begin(), grid_.begin() + r.end(), Node::Zero());
+                      });
   }
 
   void particle_to_grid() {
@@ -145,8 +145,9 @@ class LimitKernel {
             const IVec<Dim> node = base + off;
             const Vec<Dim> dpos = (node.template cast<double>() - xg) * dx_;
             const std::size_t f = flat(node);
-            grid_mass_[f] += wt * m;
-            grid_vel_[f] += wt * (mv + affine * dpos);
+            Node& g = grid_[f];
+            g[0] += wt * m;
+            g.template tail<Dim>() += wt * (mv + affine * dpos);
           });
         }
       });
@@ -154,11 +155,12 @@ class LimitKernel {
   }
 
   void grid_update() {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid_mass_.size(), 16 * kGrain),
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid_.size(), 16 * kGrain),
                       [&](const auto& r) {
                         for (std::size_t f = r.begin(); f != r.end(); ++f) {
-                          if (grid_mass_[f] > 0.0)
-                            grid_vel_[f] = grid_vel_[f] / grid_mass_[f] + dt_ * gravity_;
+                          Node& g = grid_[f];
+                          if (g[0] > 0.0)
+                            g.template tail<Dim>() = g.template tail<Dim>() / g[0] + dt_ * gravity_;
                         }
                       });
   }
@@ -181,7 +183,7 @@ class LimitKernel {
             for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
               const IVec<Dim> node = base + off;
               const Vec<Dim> dpos = (node.template cast<double>() - xg) * dx_;
-              const Vec<Dim>& vi = grid_vel_[flat(node)];
+              const Vec<Dim> vi = grid_[flat(node)].template tail<Dim>();
               v += wt * vi;
               b += wt * vi * dpos.transpose();
             });
@@ -209,8 +211,11 @@ class LimitKernel {
   std::vector<Mat<Dim>> C_, F_, tau_;
   std::vector<double> mass_, vol0_;
   IVec<Dim> grid_lo_, grid_n_;
-  std::vector<double> grid_mass_;
-  std::vector<Vec<Dim>> grid_vel_;
+  // One node = (mass, momentum), velocity after the grid update: one cache line per node
+  // touched instead of two arrays.
+  using Node = Eigen::Matrix<double, Dim + 1, 1>;
+  std::vector<Node> grid_;
+  std::array<std::size_t, Dim> stride_{};
   std::vector<std::size_t> slab_begin_;
 };
 
