@@ -363,7 +363,9 @@ SceneConfig scene_from_json(const nlohmann::json& j) {
       if (!w->is_array()) fail("domain.wall_axes", "must be an array of axis numbers");
       for (const auto& a : *w) {
         if (!a.is_number_integer()) fail("domain.wall_axes", "must contain integers only");
-        s.wall_axes.push_back(static_cast<int>(std::clamp<std::int64_t>(a.get<std::int64_t>(), -1, 3)));
+        const auto axis = a.get<std::int64_t>();
+        if (axis < 0 || axis > 2) fail("domain.wall_axes", "axis " + std::to_string(axis) + " is not in [0, dim)");
+        s.wall_axes.push_back(static_cast<int>(axis));
       }
     }
     o.refuse_unknown();
