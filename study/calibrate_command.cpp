@@ -85,9 +85,9 @@ QuantityLaws laws_from_records(const std::vector<FitRecord>& records) {
     out.model =
         std::string("one regime (single power law; ") +
         (below && above ? "a second regime is not warranted)" : "too few cases for a broken line)");
-    out.regimes.push_back({"single law", single->x_min.value_or(NAN), single->x_max.value_or(NAN),
-                           single->y_min.value_or(NAN), single->y_max.value_or(NAN),
-                           single->law()});
+    out.regimes.push_back({"one regime (all Π)", single->x_min.value_or(NAN),
+                           single->x_max.value_or(NAN), single->y_min.value_or(NAN),
+                           single->y_max.value_or(NAN), single->law()});
   }
   return out;
 }

@@ -7,6 +7,7 @@
 #include <set>
 
 #include "engine/error.hpp"
+#include "study/fits_table.hpp"
 #include "study/store.hpp"
 
 namespace crevasse {
@@ -143,6 +144,10 @@ std::vector<fs::path> export_csv(const fs::path& db_path, const fs::path& dir) {
   }
   files.push_back(dir / "cases.csv");
   export_cases(store.handle(), files.back());
+  if (has_fits_table(store)) {
+    files.push_back(dir / "fits.csv");
+    export_table(store.handle(), "fits", files.back());
+  }
   store.exec("COMMIT");
   return files;
 }

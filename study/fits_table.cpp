@@ -227,15 +227,17 @@ void replace_fit_records(Store& store, const std::string& quantity, const std::s
   });
 }
 
+bool has_fits_table(Store& store) {
+  Statement t(store.handle(),
+              "SELECT count(*) FROM sqlite_master WHERE type = 'table' AND name = 'fits'");
+  t.step();
+  return t.integer(0) > 0;
+}
+
 std::vector<FitRecord> read_fit_records(Store& store, const std::string& quantity,
                                         const std::string& group_name) {
   std::vector<FitRecord> out;
-  {
-    Statement t(store.handle(),
-                "SELECT count(*) FROM sqlite_master WHERE type = 'table' AND name = 'fits'");
-    t.step();
-    if (t.integer(0) == 0) return out;
-  }
+  if (!has_fits_table(store)) return out;
   Statement s(store.handle(), std::string("SELECT ") + kColumns +
                                   " FROM fits WHERE quantity = ? AND group_name = ? ORDER BY "
                                   "model DESC, regime");

@@ -54,6 +54,9 @@ std::vector<FitRecord> fit_records(const StudyFit& fit, const std::string& creat
 void replace_fit_records(Store& store, const std::string& quantity, const std::string& group_name,
                          const std::vector<FitRecord>& records);
 
+// Whether `crevasse fit` has created the table (it is not part of the study schema).
+bool has_fits_table(Store& store);
+
 // Rows of (quantity, group_name); empty when there are none or the table does not exist.
 std::vector<FitRecord> read_fit_records(Store& store, const std::string& quantity,
                                         const std::string& group_name);

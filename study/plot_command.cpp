@@ -208,7 +208,7 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
   std::vector<analysis::NamedSample> samples;
   for (const CaseRecord* c : cdf_cases) {
     analysis::NamedSample sample;
-    sample.name = "#" + std::to_string(c->case_index) + " " +
+    sample.name = "case " + std::to_string(c->case_index) + ": " +
                   group_value_label(group, c->group(group)) +
                   (std::string(group.name) == "thickness"
                        ? ""

@@ -4,12 +4,14 @@
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <spawn.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <thread>
 
@@ -138,6 +140,30 @@ inline std::vector<std::string> result_dump(const std::filesystem::path& db) {
 inline std::string pragma_integrity(const std::filesystem::path& db) {
   const auto rows = dump_rows(db, "PRAGMA integrity_check");
   return rows.empty() ? "" : rows.front();
+}
+
+inline std::string read_file(const std::filesystem::path& p) {
+  std::ifstream f(p);
+  std::ostringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+struct CliResult {
+  int code = -1;
+  std::string out, err;
+};
+
+// Runs the crevasse binary with `args` (already shell-quoted where needed) in `dir`.
+inline CliResult run_cli(const std::filesystem::path& dir, const std::string& args) {
+  const std::string cmd = "cd '" + dir.string() + "' && '" CREVASSE_BINARY "' " + args +
+                          " > cli_out.txt 2> cli_err.txt";
+  const int status = std::system(cmd.c_str());
+  CliResult r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = read_file(dir / "cli_out.txt");
+  r.err = read_file(dir / "cli_err.txt");
+  return r;
 }
 
 // Starts the crevasse binary (CREVASSE_BINARY) with `args`, its stderr to `stderr_path`;

@@ -20,29 +20,9 @@ namespace {
 
 using namespace std::chrono_literals;
 
-std::string read_file(const std::filesystem::path& p) {
-  std::ifstream f(p);
-  std::ostringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
-struct Result {
-  int code = -1;
-  std::string out, err;
-};
-
-// Runs the crevasse binary with `args` (already shell-quoted where needed) in `dir`.
-Result run_cli(const std::filesystem::path& dir, const std::string& args) {
-  const std::string cmd = "cd '" + dir.string() + "' && '" CREVASSE_BINARY "' " + args +
-                          " > cli_out.txt 2> cli_err.txt";
-  const int status = std::system(cmd.c_str());
-  Result r;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = read_file(dir / "cli_out.txt");
-  r.err = read_file(dir / "cli_err.txt");
-  return r;
-}
+using test::read_file;
+using test::run_cli;
+using Result = test::CliResult;
 
 TEST(Cli, InvalidStudyFilesExitWithCode2AndCreateNoDatabase) {
   test::ScratchDir dir("cli");

@@ -1,0 +1,329 @@
+// crevasse fit / plot / calibrate / predict on small synthetic study databases written through
+// the store API with known laws: the fitted intervals hold the true exponents, prefactors and
+// breakpoint; the fits table is written (and rewritten) without touching the study's tables;
+// figures are written with every case on them; calibration inverts its own prediction; bad
+// input exits with code 2 and one line naming the option.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <random>
+#include <regex>
+
+#include "study/fits_table.hpp"
+#include "study_test_support.hpp"
+
+namespace crevasse {
+namespace {
+
+// What a synthetic case produced: medians of L_p/H_i and D_p/H_i, or nothing.
+struct FakeResult {
+  enum Kind { measured, no_crevasse, failed } kind = measured;
+  double spacing_over_h = 0.0;
+  double depth_over_h = 0.0;
+};
+
+// A study over cohesion_ratio (log, `n_pi` values from 0.05 to 1; 0.2 alone for 1) × thickness;
+// every case's result from `make`. Each measured case gets 7 crevasses whose spacings spread ±20 %
+// about the median.
+void write_synthetic_db(const std::filesystem::path& db, int n_pi,
+                        const std::vector<double>& thicknesses,
+                        const std::function<FakeResult(const StudyCase&)>& make) {
+  nlohmann::json j = test::tiny_study(n_pi, 100, "synthetic");
+  j["sweep"]["thickness"] = thicknesses;
+  if (n_pi == 1) j["sweep"]["cohesion_ratio"] = {0.2};
+  const Study study = test::parse(j);
+  Store store = Store::open_writer(db);
+  store.init_study(study);
+  std::vector<const StudyCase*> cases;
+  for (const auto& c : study.cases) cases.push_back(&c);
+  store.add_cases(cases);
+  for (const StudyCase& c : study.cases) {
+    const FakeResult f = make(c);
+    CaseResult r;
+    r.case_id = c.case_id;
+    r.session_id = "synthetic";
+    r.status = f.kind == FakeResult::failed ? "failed" : "done";
+    r.failure_reason = "synthetic failure";
+    r.result_json = {{"index", c.index}};
+    if (f.kind != FakeResult::failed) {
+      const double h = c.groups.thickness_m;
+      analysis::CrevasseMeasurement m;
+      m.settings.ice_thickness_m = h;
+      if (f.kind == FakeResult::no_crevasse) {
+        m.flags.no_crevasse = true;
+      } else {
+        const double l = f.spacing_over_h * h, d = f.depth_over_h * h;
+        const std::vector<double> factors = {0.8, 0.9, 0.95, 1.0, 1.05, 1.1, 1.2};
+        double x = 0.0;
+        for (std::size_t k = 0; k < factors.size(); ++k) {
+          analysis::Crevasse cr;
+          cr.x_m = x;
+          cr.depth_m = d;
+          cr.surface_z_m = h;
+          cr.bottom_z_m = h - d;
+          if (k + 1 < factors.size()) {
+            cr.spacing_to_next_m = l * factors[k];
+            m.spacings_m.push_back(l * factors[k]);
+            x += l * factors[k];
+          }
+          m.crevasses.push_back(cr);
+        }
+        m.flags.has_spacing = true;
+        m.spacing_m = analysis::QuartileSummary{0.925 * l, l, 1.075 * l};
+        m.spacing_over_h = analysis::QuartileSummary{0.925 * f.spacing_over_h, f.spacing_over_h,
+                                                     1.075 * f.spacing_over_h};
+        m.depth_m = analysis::QuartileSummary{0.9 * d, d, 1.1 * d};
+        m.depth_over_h =
+            analysis::QuartileSummary{0.9 * f.depth_over_h, f.depth_over_h, 1.1 * f.depth_over_h};
+      }
+      r.measurement = m;
+    }
+    store.record_result(r);
+  }
+  store.checkpoint();
+}
+
+// L_p/H_i = 2 Π^0.5 (one regime); D_p/H_i a broken line: 0.8 (Π/0.2)^1 below Π* = 0.2,
+// 0.8 (Π/0.2)^0.3 above; log-normal scatter σ = 0.05 from a fixed seed.
+constexpr double kA = 2.0, kB = 0.5, kBreak = 0.2, kB1 = 1.0, kB2 = 0.3, kYStar = 0.8;
+
+double true_depth(double pi) { return kYStar * std::pow(pi / kBreak, pi < kBreak ? kB1 : kB2); }
+
+std::function<FakeResult(const StudyCase&)> known_laws(double sigma) {
+  auto rng = std::make_shared<std::mt19937>(12345);
+  return [rng, sigma](const StudyCase& c) {
+    std::normal_distribution<double> noise(0.0, sigma);
+    const double pi = c.groups.cohesion_ratio;
+    FakeResult f;
+    f.spacing_over_h = kA * std::pow(pi, kB) * std::exp(noise(*rng));
+    f.depth_over_h = true_depth(pi) * std::exp(noise(*rng));
+    return f;
+  };
+}
+
+const FitRecord& row(const std::vector<FitRecord>& rows, const std::string& model,
+                     const std::string& regime) {
+  for (const FitRecord& r : rows)
+    if (r.model == model && r.regime == regime) return r;
+  throw std::runtime_error("no fits row " + model + "/" + regime);
+}
+
+bool within(const std::optional<double>& lo, double v, const std::optional<double>& hi) {
+  return lo && hi && *lo <= v && v <= *hi;
+}
+
+void expect_one_line_error(const test::CliResult& r, const std::string& names) {
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_EQ(r.err.rfind("crevasse: error: ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find(names), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one line: " << r.err;
+}
+
+TEST(FitCli, RecoversKnownLawsAndStoresTheFitsTable) {
+  test::ScratchDir dir("fit");
+  write_synthetic_db(dir / "s.db", 15, {100.0, 300.0}, known_laws(0.05));
+  const auto before = test::result_dump(dir / "s.db");
+
+  const test::CliResult fit = test::run_cli(dir.path(), "fit s.db");
+  ASSERT_EQ(fit.code, 0) << fit.err;
+  for (const char* text : {"L_p/H_i", "D_p/H_i", "single", "broken", "below", "above",
+                           "two regimes", "30 of 30 cases fitted", "stored 6 row(s)"})
+    EXPECT_NE(fit.out.find(text), std::string::npos) << text << "\n" << fit.out;
+
+  Store store = Store::open_reader(dir / "s.db");
+  const auto spacing = read_fit_records(store, "spacing_over_h", "cohesion_ratio");
+  const FitRecord& single = row(spacing, "single", "all");
+  ASSERT_TRUE(single.ok()) << single.note;
+  EXPECT_EQ(single.n, 30);
+  EXPECT_TRUE(within(single.exponent_lo, kB, single.exponent_hi));
+  EXPECT_TRUE(within(single.prefactor_lo, kA, single.prefactor_hi));
+  EXPECT_GT(*single.r_squared, 0.95);
+  EXPECT_FALSE(*single.two_regimes) << "one law was generated";
+
+  const auto depth = read_fit_records(store, "depth_over_h", "cohesion_ratio");
+  const FitRecord& below = row(depth, "broken", "below");
+  const FitRecord& above = row(depth, "broken", "above");
+  EXPECT_TRUE(*below.two_regimes);
+  EXPECT_TRUE(within(below.breakpoint_lo, kBreak, below.breakpoint_hi))
+      << *below.breakpoint_lo << " " << *below.breakpoint_hi;
+  EXPECT_TRUE(within(below.exponent_lo, kB1, below.exponent_hi));
+  EXPECT_TRUE(within(above.exponent_lo, kB2, above.exponent_hi));
+  EXPECT_EQ(below.n + above.n, 30);
+
+  // Fitting again, now with the lower exponent held at 1, replaces the rows; the study's own
+  // tables are untouched.
+  const test::CliResult again =
+      test::run_cli(dir.path(), "fit s.db --fixed-depth-exponents 1,free --group all");
+  ASSERT_EQ(again.code, 0) << again.err;
+  EXPECT_NE(again.out.find("against thickness"), std::string::npos) << again.out;
+  EXPECT_EQ(
+      test::dump_rows(dir / "s.db", "SELECT count(*) FROM fits WHERE group_name = 'cohesion_ratio'")
+          .at(0),
+      "6");
+  const auto held = read_fit_records(store, "depth_over_h", "cohesion_ratio");
+  EXPECT_TRUE(row(held, "broken", "below").exponent_fixed);
+  EXPECT_EQ(row(held, "broken", "below").fixed_exponents, "1,free");
+  EXPECT_EQ(test::result_dump(dir / "s.db"), before);
+  ASSERT_EQ(test::run_cli(dir.path(), "export s.db --csv csv").code, 0);
+  EXPECT_NE(test::read_file(dir / "csv" / "fits.csv").find("spacing_over_h,cohesion_ratio,single"),
+            std::string::npos);
+  EXPECT_EQ(test::pragma_integrity(dir / "s.db"), "ok");
+}
+
+TEST(FitCli, DegenerateStudiesGiveNotEnoughDataRowsNeverACrash) {
+  test::ScratchDir dir("fit");
+  // One measured case; the rest failed or without crevasses.
+  write_synthetic_db(dir / "one.db", 4, {100.0}, [](const StudyCase& c) {
+    FakeResult f;
+    f.kind = c.index == 0   ? FakeResult::measured
+             : c.index == 1 ? FakeResult::failed
+                            : FakeResult::no_crevasse;
+    f.spacing_over_h = f.depth_over_h = 1.0;
+    return f;
+  });
+  const test::CliResult one = test::run_cli(dir.path(), "fit one.db");
+  EXPECT_EQ(one.code, 0) << one.err;
+  EXPECT_NE(one.out.find("NOT ENOUGH DATA: 1 case(s) with a value"), std::string::npos) << one.out;
+  EXPECT_NE(one.out.find("1 failed, 2 no crevasse"), std::string::npos) << one.out;
+  EXPECT_EQ(test::dump_rows(dir / "one.db", "SELECT DISTINCT status FROM fits"),
+            std::vector<std::string>{"not_enough_data"});
+
+  // All cases at one Π: the group does not vary.
+  write_synthetic_db(dir / "flat.db", 1, {100.0, 200.0, 300.0, 400.0}, known_laws(0.05));
+  const test::CliResult flat = test::run_cli(dir.path(), "fit flat.db");
+  EXPECT_EQ(flat.code, 0) << flat.err;
+  EXPECT_NE(flat.out.find("(the group does not vary)"), std::string::npos) << flat.out;
+
+  // No case with a crevasse: fit, plot and calibrate say so.
+  write_synthetic_db(dir / "none.db", 5, {100.0}, [](const StudyCase&) {
+    return FakeResult{FakeResult::no_crevasse, 0.0, 0.0};
+  });
+  const test::CliResult none = test::run_cli(dir.path(), "fit none.db");
+  EXPECT_EQ(none.code, 0) << none.err;
+  EXPECT_NE(none.out.find("0 of 5 cases fitted; not fitted: 5 no crevasse"), std::string::npos)
+      << none.out;
+  const test::CliResult plot = test::run_cli(dir.path(), "plot none.db --out figs");
+  EXPECT_EQ(plot.code, 0) << plot.err;
+  EXPECT_NE(plot.out.find("spacing CDF figure not drawn"), std::string::npos) << plot.out;
+  EXPECT_TRUE(std::filesystem::exists(dir / "figs" / "spacing_vs_cohesion_ratio.png"));
+  expect_one_line_error(test::run_cli(dir.path(), "calibrate --db none.db --spacing 100"),
+                        "no law of L_p/H_i");
+
+  // An empty database (no study) and a missing one.
+  { Store empty = Store::open_writer(dir / "empty.db"); }
+  expect_one_line_error(test::run_cli(dir.path(), "fit empty.db"), "holds no study");
+  expect_one_line_error(test::run_cli(dir.path(), "fit missing.db"), "no such database");
+  expect_one_line_error(test::run_cli(dir.path(), "plot empty.db --out f2"), "holds no study");
+  EXPECT_FALSE(std::filesystem::exists(dir / "f2"));
+}
+
+TEST(FitCli, BadOptionsExitWith2AndOneLineNamingTheOption) {
+  test::ScratchDir dir("fit");
+  write_synthetic_db(dir / "s.db", 8, {100.0}, known_laws(0.05));
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"fit s.db --group bogus", "--group"},
+      {"fit s.db --fixed-exponents 1", "--fixed-exponents"},
+      {"fit s.db --fixed-exponents 1,x", "--fixed-exponents"},
+      {"fit s.db --level 2", "--level"},
+      {"fit s.db --level abc", "--level"},
+      {"fit", "db"},
+      {"plot s.db --out f --cdf-cases 99", "--cdf-cases"},
+      {"plot s.db --out f --cdf-normalise mean", "--cdf-normalise"},
+      {"plot s.db --out f --model curvy", "--model"},
+      {"plot s.db --out f --colour-by colour", "--colour-by"},
+      {"calibrate --db s.db --spacing -3", "--spacing"},
+      {"calibrate --db s.db --spacing 100 --thickness 0", "--thickness"},
+      {"calibrate --db s.db --spacing 100 --spacing-quartiles 120,150", "--spacing-quartiles"},
+      {"calibrate --db s.db --spacing 100 --spacing-quartiles 80", "--spacing-quartiles"},
+      {"predict --db s.db --cohesion 1e6", "--thickness"},
+      {"predict --db s.db --cohesion abc --thickness 100", "--cohesion"},
+  };
+  for (const auto& [args, names] : bad) {
+    SCOPED_TRACE(args);
+    expect_one_line_error(test::run_cli(dir.path(), args), names);
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "f")) << "a refused plot created its directory";
+  EXPECT_EQ(
+      test::dump_rows(dir / "s.db", "SELECT count(*) FROM sqlite_master WHERE name = 'fits'").at(0),
+      "0");
+}
+
+TEST(FitCli, PlotWritesEveryFigureWithEveryCaseMarked) {
+  test::ScratchDir dir("fit");
+  auto laws = known_laws(0.05);
+  write_synthetic_db(dir / "s.db", 12, {100.0, 300.0}, [&](const StudyCase& c) {
+    FakeResult f = laws(c);
+    if (c.index == 3) f.kind = FakeResult::failed;
+    if (c.index == 8) f.kind = FakeResult::no_crevasse;
+    return f;
+  });
+  ASSERT_EQ(test::run_cli(dir.path(), "fit s.db").code, 0);
+  const test::CliResult plot =
+      test::run_cli(dir.path(), "plot s.db --out figs --cdf-cases 0,23 --cdf-normalise thickness");
+  ASSERT_EQ(plot.code, 0) << plot.err;
+  EXPECT_NE(plot.out.find("24 case(s) drawn (no value: 1 failed, 1 no crevasse)"),
+            std::string::npos)
+      << plot.out;
+  for (const char* stem : {"spacing_vs_cohesion_ratio", "depth_vs_cohesion_ratio", "spacing_cdf"})
+    for (const char* ext : {".png", ".svg"})
+      EXPECT_GT(std::filesystem::file_size(dir / "figs" / (std::string(stem) + ext)), 1000u)
+          << stem << ext;
+  const std::string depth_svg = test::read_file(dir / "figs" / "depth_vs_cohesion_ratio.svg");
+  for (const char* text : {"legend: failed", "legend: no crevasse", "legend: H_i = 100 m",
+                           "legend: H_i = 300 m", "broken-line fit", "b_1 = ", "Π^* = "})
+    EXPECT_NE(depth_svg.find(text), std::string::npos) << text;
+  const std::string spacing_svg = test::read_file(dir / "figs" / "spacing_vs_cohesion_ratio.svg");
+  EXPECT_NE(spacing_svg.find("power-law fit"), std::string::npos);
+  const std::string cdf_svg = test::read_file(dir / "figs" / "spacing_cdf.svg");
+  EXPECT_NE(cdf_svg.find("case 23: "), std::string::npos);
+  EXPECT_NE(cdf_svg.find("L_p/H_i"), std::string::npos);
+}
+
+double number_after(const std::string& text, const std::string& label) {
+  const auto at = text.find(label);
+  if (at == std::string::npos) throw std::runtime_error("'" + label + "' not in:\n" + text);
+  return std::stod(text.substr(at + label.size()));
+}
+
+TEST(FitCli, CalibrateInvertsPredict) {
+  test::ScratchDir dir("fit");
+  write_synthetic_db(dir / "s.db", 10, {100.0, 200.0}, known_laws(0.05));
+  ASSERT_EQ(test::run_cli(dir.path(), "fit s.db").code, 0);
+
+  // c = 0.3 ρ g H at H = 150 m: inside the study's Π range.
+  const double c = 0.3 * 917.0 * 9.81 * 150.0;
+  const test::CliResult predict = test::run_cli(
+      dir.path(), "predict --db s.db --cohesion " + std::to_string(c) + " --thickness 150");
+  ASSERT_EQ(predict.code, 0) << predict.err;
+  const double spacing = number_after(predict.out, "median spacing L_p = ");
+  EXPECT_NEAR(spacing / 150.0, kA * std::pow(0.3, kB), 0.05 * kA * std::pow(0.3, kB));
+  EXPECT_NE(predict.out.find("median depth D_p = "), std::string::npos) << predict.out;
+
+  const test::CliResult calibrate = test::run_cli(
+      dir.path(), "calibrate --db s.db --spacing " + std::to_string(spacing) + " --thickness 150");
+  ASSERT_EQ(calibrate.code, 0) << calibrate.err;
+  const double c_hat = number_after(calibrate.out, "tensile strength c = ");
+  EXPECT_NEAR(c_hat, c, 1e-3 * c) << calibrate.out;
+  const auto at = calibrate.out.find("interval [");
+  ASSERT_NE(at, std::string::npos);
+  const double lo = std::stod(calibrate.out.substr(at + 10));
+  const double hi = number_after(calibrate.out.substr(at), ", ");
+  EXPECT_LT(lo, c);
+  EXPECT_GT(hi, c);
+  EXPECT_NE(calibrate.out.find("inside this regime's Π range"), std::string::npos) << calibrate.out;
+
+  // Outside what the study covered: refused, not extrapolated.
+  expect_one_line_error(
+      test::run_cli(dir.path(), "calibrate --db s.db --spacing 10000 --thickness 150"),
+      "--spacing");
+  expect_one_line_error(
+      test::run_cli(dir.path(), "predict --db s.db --cohesion 1e9 --thickness 150"),
+      "not extrapolated");
+  // Without H_i, b = 0.5 excludes 1: H_i is needed.
+  expect_one_line_error(test::run_cli(dir.path(), "calibrate --db s.db --spacing 100"),
+                        "thickness H_i is needed");
+}
+
+}  // namespace
+}  // namespace crevasse
