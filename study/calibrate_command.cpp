@@ -85,7 +85,7 @@ QuantityLaws laws_from_records(const std::vector<FitRecord>& records) {
     out.model =
         std::string("one regime (single power law; ") +
         (below && above ? "a second regime is not warranted)" : "too few cases for a broken line)");
-    out.regimes.push_back({"one regime (all Π)", single->x_min.value_or(NAN),
+    out.regimes.push_back({"all Π (one regime)", single->x_min.value_or(NAN),
                            single->x_max.value_or(NAN), single->y_min.value_or(NAN),
                            single->y_max.value_or(NAN), single->law()});
   }
@@ -238,7 +238,7 @@ int calibrate_command(const CalibrateCommandOptions& opt) {
   std::printf("\n");
   for (std::size_t k = 0; k < answers.size(); ++k) {
     const QuantityRegime& r = laws.spacing.regimes[k];
-    std::printf("\nregime %s: %s\n", r.name.c_str(), law_text("L_p/H_i", r).c_str());
+    std::printf("\nregime '%s': %s\n", r.name.c_str(), law_text("L_p/H_i", r).c_str());
     if (!answers[k].estimate) {
       std::printf("  refused: %s\n", answers[k].refusal.c_str());
       continue;
