@@ -13,21 +13,12 @@
 #include "engine/run.hpp"
 #include "engine/vtu_writer.hpp"
 #include "study/progress_printer.hpp"
+#include "study/scene_file.hpp"
 
 namespace crevasse {
 namespace fs = std::filesystem;
 
 namespace {
-
-nlohmann::json read_json_file(const std::string& path) {
-  std::ifstream f(path);
-  if (!f) throw InputError(path + ": cannot open the file");
-  try {
-    return nlohmann::json::parse(f);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path + ": not valid JSON (" + std::string(e.what()) + ")");
-  }
-}
 
 class CliObserver : public RunObserver {
  public:
@@ -36,9 +27,11 @@ class CliObserver : public RunObserver {
     if (quiet_) return;
     char buf[256];
     std::snprintf(buf, sizeof buf,
-                  "[%3.0f%%] t = %.1f s  front x = %.0f m  %lld steps  %.0f steps/s  %.2f M particle-steps/s  ETA %s",
-                  100.0 * p.fraction_done, p.sim_time_s, p.front_x_m, static_cast<long long>(p.steps),
-                  p.steps_per_second, p.particle_steps_per_second / 1e6, format_duration(p.eta_s).c_str());
+                  "[%3.0f%%] t = %.1f s  front x = %.0f m  %lld steps  %.0f steps/s  %.2f M "
+                  "particle-steps/s  ETA %s",
+                  100.0 * p.fraction_done, p.sim_time_s, p.front_x_m,
+                  static_cast<long long>(p.steps), p.steps_per_second,
+                  p.particle_steps_per_second / 1e6, format_duration(p.eta_s).c_str());
     printer_.update(buf);
   }
   void on_output(const ParticleSnapshot& s, int index) override {
@@ -60,19 +53,21 @@ class CliObserver : public RunObserver {
 }  // namespace
 
 int run_command(const RunCommandOptions& opt) {
-  SceneConfig scene = scene_from_json(read_json_file(opt.scene_path));
+  SceneConfig scene = load_scene_file(opt.scene_path);
   if (opt.vtu_interval >= 0) scene.vtu_interval = opt.vtu_interval;
   const fs::path out(opt.out_dir);
   std::error_code ec;
   fs::create_directories(out / "snapshots", ec);
-  if (ec) throw InputError("--out: cannot create directory " + out.string() + " (" + ec.message() + ")");
+  if (ec)
+    throw InputError("--out: cannot create directory " + out.string() + " (" + ec.message() + ")");
   {
     std::ofstream f(out / "scene_resolved.json");
     f << scene_to_json(scene).dump(2) << "\n";
   }
   std::unique_ptr<tbb::global_control> threads;
   if (opt.threads > 0)
-    threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, opt.threads);
+    threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                    opt.threads);
 
   CliObserver obs(out, opt.quiet);
   RunSummary r = run_scene(scene, &obs);
@@ -98,21 +93,26 @@ int run_command(const RunCommandOptions& opt) {
   std::ofstream(out / "run_summary.json") << summary.dump(2) << "\n";
 
   // Crevasses at the end of the run (SPEC §5), and the side view with each one marked.
-  const analysis::CrevasseMeasurement m = analysis::measure_crevasses(r.final_snapshot, analysis::MeasureSettings{});
+  const analysis::CrevasseMeasurement m =
+      analysis::measure_crevasses(r.final_snapshot, analysis::MeasureSettings{});
   analysis::write_crevasses_csv(m, out / "crevasses.csv");
   analysis::write_measurement_summary(m, out / "measurement.json");
   if (scene.png && r.final_snapshot.size() > 0) {
     analysis::SideViewOptions view;
     char extra[128];
-    const double pi_group = scene.tensile_strength / (scene.density * scene.gravity * scene.ice_thickness);
-    std::snprintf(extra, sizeof extra, "c = %.3g MPa   Pi = %.3g", scene.tensile_strength / 1e6, pi_group);
+    const double pi_group =
+        scene.tensile_strength / (scene.density * scene.gravity * scene.ice_thickness);
+    std::snprintf(extra, sizeof extra, "c = %.3g MPa   Pi = %.3g", scene.tensile_strength / 1e6,
+                  pi_group);
     view.title_extra = extra;
     analysis::write_side_view_png(r.final_snapshot, (out / "side_view.png").string(), view, &m);
   }
   if (!opt.quiet) {
-    std::fprintf(stderr, "done: %s after %lld steps, t = %.1f s, wall %.1f s (%.2f M particle-steps/s) -> %s\n",
-                 r.stop_reason.c_str(), static_cast<long long>(r.steps), r.sim_time_s, r.wall_s,
-                 r.wall_s > 0 ? r.particle_steps / r.wall_s / 1e6 : 0.0, out.string().c_str());
+    std::fprintf(
+        stderr,
+        "done: %s after %lld steps, t = %.1f s, wall %.1f s (%.2f M particle-steps/s) -> %s\n",
+        r.stop_reason.c_str(), static_cast<long long>(r.steps), r.sim_time_s, r.wall_s,
+        r.wall_s > 0 ? r.particle_steps / r.wall_s / 1e6 : 0.0, out.string().c_str());
   }
   return 0;
 }

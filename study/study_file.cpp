@@ -10,6 +10,7 @@
 
 #include "engine/error.hpp"
 #include "study/case_hash.hpp"
+#include "study/scene_file.hpp"
 
 namespace crevasse {
 namespace {
@@ -98,6 +99,13 @@ void check_pointer(const std::string& field, const std::string& ptr) {
     fail(field, "'" + ptr + "' is not a valid JSON pointer (" + e.what() + ")");
   }
   static const json reference = scene_to_json(SceneConfig{});
+  // Array indices: setting element 10^11 would allocate every element before it.
+  std::istringstream all(ptr.substr(1));
+  for (std::string t; std::getline(all, t, '/');)
+    if (!t.empty() &&
+        std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; }) &&
+        (t.size() > 4 || std::stoi(t) > 1000))
+      fail(field, "'" + ptr + "': array index " + t + " is outside the allowed range [0, 1000]");
   const json* node = &reference;
   std::string walked;
   std::istringstream tokens(ptr.substr(1));
@@ -158,17 +166,13 @@ double number_at(const json& j, const std::string& ptr, double fallback) {
 json read_json_text(const std::string& text, const std::string& source) {
   try {
     return json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // also out_of_range: 1e400
     throw InputError(source + ": not valid JSON (" + e.what() + ")");
   }
 }
 
 std::string read_text(const std::filesystem::path& path, const std::string& field) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) fail(field, "cannot open '" + path.string() + "'");
-  std::ostringstream s;
-  s << f.rdbuf();
-  return s.str();
+  return read_input_file(path, field);
 }
 
 // Every key of `obj` must be one of `allowed`.
@@ -328,7 +332,7 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
   ordered_json doc;
   try {
     doc = ordered_json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // also out_of_range: 1e400
     throw InputError(source + ": not valid JSON (" + e.what() + ")");
   }
   if (!doc.is_object()) fail(source, "a study file must be a JSON object");
@@ -450,17 +454,22 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
     }
     json scene = st.base_scene;
     std::map<std::string, double> named;
-    auto apply = [&](const std::string& name, const json& v) {
-      if (is_pointer(name))
-        scene[json::json_pointer(name)] = v;
-      else
+    auto apply = [&](const std::string& field, const std::string& name, const json& v) {
+      if (!is_pointer(name)) {
         named[name] = v.get<double>();
+        return;
+      }
+      try {
+        scene[json::json_pointer(name)] = v;
+      } catch (const json::exception& e) {  // a non-numeric array index, a path through a value
+        fail(field, "cannot set '" + name + "' in this base scene (" + e.what() + ")");
+      }
     };
-    for (const auto& [name, v] : st.fixed) apply(name, v);
+    for (const auto& [name, v] : st.fixed) apply("fixed." + name, name, v);
     c.axes = json::object();
     for (std::size_t k = 0; k < st.axes.size(); ++k) {
       const json& v = st.axes[k].values[digit[k]];
-      apply(st.axes[k].name, v);
+      apply("sweep." + st.axes[k].name, st.axes[k].name, v);
       c.axes[st.axes[k].name] = v;
       c.label += (c.label.empty() ? "" : " ") + st.axes[k].name + "=" + value_label(v);
     }
@@ -472,7 +481,11 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
     if (c.label.empty()) c.label = "base";
     const std::string where = "case " + std::to_string(index) + " (" + c.label + ")";
 
-    // Derived dimensional parameters (SPEC §1).
+    // Derived dimensional parameters (SPEC §1), written into these sections.
+    for (const char* section : {"ice", "bed", "numerics", "run"})
+      if (scene.contains(section) && !scene.at(section).is_object())
+        fail(where,
+             std::string(section) + ": must be a JSON object, got " + scene.at(section).dump());
     const auto has = [&](const char* n) { return named.count(n) > 0; };
     double h_i = number_at(scene, "/ice/thickness", defaults.ice_thickness);
     if (has("thickness")) h_i = named["thickness"];
