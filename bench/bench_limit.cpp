@@ -178,24 +178,31 @@ class LimitKernel {
             const Vec<Dim> xg = x_[p] * inv_dx;
             const StencilWeights<Dim> w(xg);
             const IVec<Dim> base = w.base();
-            Vec<Dim> v = Vec<Dim>::Zero();
-            Mat<Dim> b = Mat<Dim>::Zero();
+            // Scalar accumulators: Eigen's outer-product temporaries of 3-vectors go through
+            // the stack and stall on store forwarding (3× slower in 3D).
+            std::array<double, Dim> v{};
+            std::array<double, Dim * Dim> b{};
             for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
               const IVec<Dim> node = base + off;
-              const Vec<Dim> dpos = (node.template cast<double>() - xg) * dx_;
-              const Vec<Dim> vi = grid_[flat(node)].template tail<Dim>();
-              v += wt * vi;
-              b += wt * vi * dpos.transpose();
+              const Node& g = grid_[flat(node)];
+              for (int a = 0; a < Dim; ++a) {
+                const double wv = wt * g[a + 1];
+                v[a] += wv;
+                for (int k = 0; k < Dim; ++k) b[a * Dim + k] += wv * (node[k] - xg[k]) * dx_;
+              }
             });
-            const Mat<Dim> c = d_inv * b;
+            Mat<Dim> c;
+            for (int a = 0; a < Dim; ++a)
+              for (int k = 0; k < Dim; ++k) c(a, k) = d_inv * b[a * Dim + k];
+            const Vec<Dim> vel = Eigen::Map<const Vec<Dim>>(v.data());
             const Mat<Dim> f = (Mat<Dim>::Identity() + dt_ * c) * F_[p];
             const Mat<Dim> eps = 0.5 * (f + f.transpose()) - Mat<Dim>::Identity();
-            x_[p] += dt_ * v;
-            v_[p] = v;
+            x_[p] += dt_ * vel;
+            v_[p] = vel;
             C_[p] = c;
             F_[p] = f;
             tau_[p] = 2.0 * mu * eps + (lambda * eps.trace()) * Mat<Dim>::Identity();
-            acc = std::max(acc, v.squaredNorm());
+            acc = std::max(acc, vel.squaredNorm());
           }
           return acc;
         },
