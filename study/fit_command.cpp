@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <set>
 
 #include "engine/error.hpp"
@@ -152,7 +153,14 @@ int fit_command(const FitCommandOptions& opt) {
     std::printf("\nnot stored (--no-store)\n");
     return 0;
   }
-  Store writer = Store::open_writer(opt.db_path);
+  std::optional<Store> opened;
+  try {
+    opened.emplace(Store::open_writer(opt.db_path));
+  } catch (const InputError& e) {
+    throw InputError(opt.db_path + ": cannot store the fits (" + e.what() +
+                     "); run crevasse fit again when the study has ended, or add --no-store");
+  }
+  Store& writer = *opened;
   std::size_t rows = 0;
   for (const auto& [group, records] : all) {
     for (Quantity q : kQuantities) {

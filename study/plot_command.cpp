@@ -193,11 +193,14 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
     std::string missing_text;
     for (const auto& [reason, k] : missing)
       missing_text += (missing_text.empty() ? "" : ", ") + std::to_string(k) + " " + reason;
-    std::printf(
-        "%s: %zu case(s) drawn (%s), fit: %s%s\n", files.front().c_str(), points.size(),
-        missing_text.empty() ? "all measured" : ("no value: " + missing_text).c_str(),
-        fit_summary(drawn, fit).c_str(),
-        skipped ? (", " + std::to_string(skipped) + " not drawn (not run yet)").c_str() : "");
+    std::printf("%s: %zu case(s) drawn (%s), fit: %s%s\n", files.front().c_str(), points.size(),
+                missing_text.empty() ? "all measured" : ("no value: " + missing_text).c_str(),
+                fit_summary(drawn, fit).c_str(),
+                skipped
+                    ? (", " + std::to_string(skipped) + " not drawn (not run yet, or no value of " +
+                       std::string(group.name) + ")")
+                          .c_str()
+                    : "");
   }
 
   if (cdf_cases.empty() && opt.cdf_cases.empty()) cdf_cases = default_cdf_cases(cases, group);
