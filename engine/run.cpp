@@ -17,14 +17,16 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
   RunSummary out;
   out.initial_mass = sim.total_mass();
   out.initial_particles = sim.particles().size();
-  const double front0 = sim.front_x();
+  // The front that counts is that of the connected ice, not of debris thrown ahead of it.
+  double ice_front = sim.ice_front_x();
+  const double front0 = ice_front;
   const double target_front = scene.step_foot_x() + scene.front_past_step;
 
   auto fraction = [&] {
     double f = 0.0;
     if (scene.end_time > 0) f = std::max(f, sim.time() / scene.end_time);
     if (scene.front_past_step > 0 && target_front > front0)
-      f = std::max(f, (sim.front_x() - front0) / (target_front - front0));
+      f = std::max(f, (ice_front - front0) / (target_front - front0));
     if (scene.max_steps > 0) f = std::max(f, static_cast<double>(sim.steps()) / scene.max_steps);
     return std::clamp(f, 0.0, 1.0);
   };
@@ -46,7 +48,8 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
   std::int64_t last_steps = 0, last_psteps = 0;
   while (true) {
     if (scene.end_time > 0 && sim.time() >= scene.end_time) { out.stop_reason = "end_time"; break; }
-    if (scene.front_past_step > 0 && sim.front_x() >= target_front) { out.stop_reason = "front_past_step"; break; }
+    if (sim.steps() % 20 == 0) ice_front = sim.ice_front_x();
+    if (scene.front_past_step > 0 && ice_front >= target_front) { out.stop_reason = "front_past_step"; break; }
     if (scene.max_steps > 0 && sim.steps() >= scene.max_steps) { out.stop_reason = "max_steps"; break; }
     if (sim.particles().size() == 0) { out.stop_reason = "no_ice_left"; break; }
     sim.step();
@@ -68,7 +71,7 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
       pr.steps_per_second = (sim.steps() - last_steps) / span;
       pr.particle_steps_per_second = (sim.particle_steps() - last_psteps) / span;
       pr.eta_s = pr.fraction_done > 0 ? wall * (1.0 - pr.fraction_done) / pr.fraction_done : 0.0;
-      pr.front_x_m = sim.front_x();
+      pr.front_x_m = ice_front;
       pr.wall_s = wall;
       obs->on_progress(pr);
       last_report = wall;
@@ -85,6 +88,7 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
   out.removed_mass = sim.removed_mass();
   out.final_particles = sim.particles().size();
   out.final_snapshot = sim.snapshot();
+  out.final_ice_front_x = sim.ice_front_x();
   // The last state is always among the snapshots, unless the last interval just wrote it.
   if (obs && scene.vtu_interval > 0 && last_output_time < sim.time())
     obs->on_output(out.final_snapshot, output_index++);

@@ -47,6 +47,7 @@ struct RunSummary {
   std::size_t initial_particles = 0;
   std::size_t final_particles = 0;
   nlohmann::json stage_seconds;  // per stage: seconds and calls
+  double final_ice_front_x = 0.0;  // front of the connected ice at the end [m]
   ParticleSnapshot final_snapshot;
 };
 

@@ -563,11 +563,17 @@ void Simulation<Dim>::average_volume_change() {
   // weights as P2G and interpolated back; each particle then takes the averaged ΔJ̄_p and keeps
   // its own isochoric part. A field that varies linearly over the stencil is reproduced, so a
   // smooth deformation is unchanged; a particle-to-particle checkerboard is removed.
+  // Only intact ice is averaged: each particle enters with weight (1 − D) (D the damage,
+  // 1 − e^{−ζ ε_v^p}) and takes ΔJ_used = (1 − D)·ΔJ̄ + D·ΔJ_p. An opening crack then keeps its
+  // volume change to itself instead of handing part of it to the intact ice around it, which
+  // would widen every crack by a cell each time it opens further.
   auto& P = particles_;
   const double inv_dx = 1.0 / scene_.dx;
   const std::size_t n = P.size();
+  const bool damage = !P.eps_v_p.empty() && plastic_.softening_zeta > 0.0 && !settling_;
+  const double zeta = plastic_.softening_zeta;
   volume_scale_.resize(n);
-  grid_aux_.assign(grid_.node_count(), 0.0);
+  grid_aux_.assign(2 * grid_.node_count(), 0.0);  // interleaved (Σ w m (1−D) ΔJ, Σ w m (1−D))
   const int slabs = static_cast<int>(slab_start_.size()) - 1;
   for (int colour = 0; colour < 2; ++colour) {
     tbb::parallel_for(0, (slabs + 1 - colour) / 2, [&](int half) {
@@ -576,28 +582,35 @@ void Simulation<Dim>::average_volume_change() {
         const std::uint32_t p = slab_order_[q];
         const double dj = (Mat<Dim>::Identity() + dt_ * P.C[p]).determinant();
         volume_scale_[p] = dj;
+        const double intact = damage ? std::exp(-zeta * P.eps_v_p[p]) : 1.0;
+        const double wm = P.mass[p] * intact;
         const StencilWeights<Dim> w(P.x[p] * inv_dx);
         const IVec<Dim> base = w.base();
         for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
-          grid_aux_[grid_.flat(base + off)] += wt * P.mass[p] * dj;
+          const std::size_t f = 2 * grid_.flat(base + off);
+          grid_aux_[f] += wt * wm * dj;
+          grid_aux_[f + 1] += wt * wm;
         });
       }
     });
   }
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid_aux_.size(), kGrain), [&](const auto& r) {
-    for (std::size_t f = r.begin(); f != r.end(); ++f)
-      if (grid_.mass[f] > 0.0) grid_aux_[f] /= grid_.mass[f];
-  });
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), [&](const auto& r) {
     for (std::size_t p = r.begin(); p != r.end(); ++p) {
       const StencilWeights<Dim> w(P.x[p] * inv_dx);
       const IVec<Dim> base = w.base();
-      double jbar = 0.0;
+      double jbar = 0.0, wsum = 0.0;
       for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
-        jbar += wt * grid_aux_[grid_.flat(base + off)];
+        const std::size_t f = 2 * grid_.flat(base + off);
+        // Nodes reached only by (nearly) broken ice carry no average.
+        if (grid_aux_[f + 1] > 1e-9 * grid_.mass[f / 2]) {
+          jbar += wt * grid_aux_[f] / grid_aux_[f + 1];
+          wsum += wt;
+        }
       });
       const double dj = volume_scale_[p];
-      volume_scale_[p] = (dj > 0.0 && jbar > 0.0) ? jbar / dj : 1.0;
+      const double intact = damage ? std::exp(-zeta * P.eps_v_p[p]) : 1.0;
+      const double used = wsum > 0.0 ? intact * (jbar / wsum) + (1.0 - intact) * dj : dj;
+      volume_scale_[p] = (dj > 0.0 && used > 0.0) ? used / dj : 1.0;
     }
   });
 }
@@ -778,6 +791,7 @@ ParticleSnapshot Simulation<Dim>::snapshot() const {
   s.ice_thickness_m = scene_.ice_thickness;
   s.step_top_x_m = scene_.step_top_x();
   s.step_foot_x_m = scene_.step_foot_x();
+  s.ice_front_x_m = ice_front_x();
   s.particle_spacing_m = scene_.dx / scene_.particles_per_cell_axis;
   if (bed_) s.bed_profile = bed_->vertices();
   const auto& P = particles_;
@@ -803,6 +817,41 @@ ParticleSnapshot Simulation<Dim>::snapshot() const {
     s.volume_m3[p] = P.vol0[p] * j_e * std::exp(eps);  // J = J_E J_P, J_P = exp(ε_v^p)
   }
   return s;
+}
+
+template <int Dim>
+double Simulation<Dim>::ice_front_x(double min_fraction) const {
+  const auto& P = particles_;
+  if (P.size() == 0) return 0.0;
+  const double dx = scene_.dx;
+  double xmin = P.x[0][0], xmax = xmin;
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    xmin = std::min(xmin, P.x[p][0]);
+    xmax = std::max(xmax, P.x[p][0]);
+  }
+  const auto columns = static_cast<std::size_t>((xmax - xmin) / dx) + 1;
+  std::vector<double> volume(columns, 0.0);
+  for (std::size_t p = 0; p < P.size(); ++p)
+    volume[static_cast<std::size_t>((P.x[p][0] - xmin) / dx)] += P.mass[p] / scene_.density;
+  double across = 1.0;  // 3D: the width of the ice across the flow
+  if constexpr (Dim == 3) across = scene_.body == "slab" ? scene_.width : scene_.box_max[1] - scene_.box_min[1];
+  const double thickness = scene_.body == "slab" ? scene_.ice_thickness
+                                                 : scene_.box_max[Dim - 1] - scene_.box_min[Dim - 1];
+  const double full = min_fraction * thickness * dx * across;
+  // Gaps upstream of the step top (a crack near the piston) do not end the ice: the walk
+  // only stops at a gap downstream of it.
+  const double gaps_from_x = scene_.body == "slab" ? scene_.step_top_x() : xmin;
+  std::size_t last_thick = 0;
+  int thin_run = 0;
+  for (std::size_t c = 0; c < columns; ++c) {
+    if (volume[c] >= full) {
+      last_thick = c;
+      thin_run = 0;
+    } else if (xmin + c * dx >= gaps_from_x && ++thin_run >= 2) {
+      break;
+    }
+  }
+  return std::min(xmax, xmin + (last_thick + 1) * dx);
 }
 
 template class Simulation<2>;

@@ -55,7 +55,12 @@ class Simulation {
   double gravitational_potential_energy() const;
   // Energy dissipated by the tensile cap, Σ V0 ∫ c e^{−ζε} dε = Σ V0 (c/ζ)(1 − e^{−ζ ε_v^p}).
   double cap_dissipated_energy() const;
-  double front_x() const { return front_x_; }
+  double front_x() const { return front_x_; }  // most downstream particle, debris included
+  // Front of the connected ice [m]: walking downstream from the back in columns one cell wide,
+  // the right edge of the last column holding at least `min_fraction` of a full column of ice
+  // (H_i thick) before two thinner columns in a row. Scattered debris ahead of the ice does
+  // not count. O(particles); the run loop calls it every few steps.
+  double ice_front_x(double min_fraction = 0.25) const;
   double max_speed() const { return max_speed_; }
   const Bed* bed() const { return bed_.has_value() ? &*bed_ : nullptr; }
   // Largest yield-function value Φ over the particles, normalised by c (≤ ~0 when admissible).

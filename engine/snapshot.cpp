@@ -12,6 +12,7 @@ double ParticleSnapshot::damage(std::size_t i) const {
 
 double ParticleSnapshot::front_x() const {
   if (x.empty()) return 0.0;
+  if (ice_front_x_m > 0.0) return ice_front_x_m;
   return *std::max_element(x.begin(), x.end());
 }
 

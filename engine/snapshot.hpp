@@ -34,7 +34,10 @@ struct ParticleSnapshot {
   std::size_t size() const { return x.size(); }
   // Fraction of strength lost, 1 − exp(−ζ ε_v^p) (SPEC §5); 0 with softening off.
   double damage(std::size_t i) const;
-  // The x of the most downstream particle (the ice front) [m].
+  // Front of the connected ice (Simulation::ice_front_x) when the engine filled it in (> 0);
+  // scattered debris ahead of the ice does not move it.
+  double ice_front_x_m = 0.0;
+  // The ice front [m]: ice_front_x_m when set, else the x of the most downstream particle.
   double front_x() const;
 };
 

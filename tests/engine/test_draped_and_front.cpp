@@ -1,0 +1,58 @@
+// Ice draped past the step (ice.draped_length) and the front of the connected ice
+// (Simulation::ice_front_x), which the run's stop rule and the measurement window use.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+
+#include "engine/simulation.hpp"
+
+namespace crevasse {
+namespace {
+
+nlohmann::json glacier_json() {
+  std::ifstream f(std::string(CREVASSE_SOURCE_DIR) + "/studies/scenes/glacier_2d.json");
+  return nlohmann::json::parse(f);
+}
+
+TEST(Draped, IceFollowsTheBedWithItsThicknessPastTheStep) {
+  nlohmann::json j = glacier_json();
+  j["ice"]["draped_length"] = 150.0;  // over the 100 m ramp and 50 m of the floor
+  const SceneConfig scene = scene_from_json(j);
+  Simulation<2> sim(scene);
+  const Bed& bed = *sim.bed();
+  const auto& P = sim.particles();
+  const double h = scene.dx / scene.particles_per_cell_axis;
+  double xmax = 0.0;
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    const double x = P.x[p][0], z = P.x[p][1];
+    xmax = std::max(xmax, x);
+    // Every particle lies between the bed and the bed + H_i (lattice half-spacing tolerance).
+    EXPECT_GE(z, bed.height_at(x) - 0.5 * h) << x;
+    EXPECT_LE(z, bed.height_at(x) + scene.ice_thickness + 0.5 * h) << x;
+  }
+  EXPECT_NEAR(xmax, scene.step_top_x() + 150.0 - 0.5 * h, 1e-9);
+  // Mass: the plateau slab plus the draped part, each H_i thick (area per lattice point h²).
+  const double area = P.size() * h * h;
+  const double expected = (scene.upstream_length + 150.0) * scene.ice_thickness;
+  EXPECT_NEAR(area, expected, 0.02 * expected);  // the lattice cuts the sloping faces by ≤ h
+}
+
+TEST(IceFront, DebrisAheadOfTheIceDoesNotMoveTheFront) {
+  nlohmann::json j = glacier_json();
+  const SceneConfig scene = scene_from_json(j);
+  Simulation<2> sim(scene);
+  const double front0 = sim.ice_front_x();
+  EXPECT_NEAR(front0, scene.step_top_x(), scene.dx);  // the slab ends at the lip
+  // Throw a few particles far downstream: the most downstream particle moves, the ice front
+  // does not.
+  auto& P = sim.mutable_particles();
+  for (std::size_t p = 0; p < 5; ++p) P.x[p][0] = scene.step_foot_x() + 200.0 + 30.0 * p;
+  EXPECT_NEAR(sim.ice_front_x(), front0, scene.dx);
+  EXPECT_GT(sim.snapshot().x.size(), 0u);
+  const auto snap = sim.snapshot();
+  EXPECT_NEAR(snap.front_x(), front0, scene.dx);  // the snapshot carries the ice front
+}
+
+}  // namespace
+}  // namespace crevasse
