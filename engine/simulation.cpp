@@ -77,6 +77,7 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   add_stage("p2g", [this] { particle_to_grid(); });
   add_stage(g != 0.0 ? "grid_velocity_gravity" : "grid_velocity",
             [this, gravity] { grid_velocity(gravity); });
+  if (scene_.has(Effect::drive)) add_stage("drive_grid", [this] { drive_grid_nodes(); });
   if (scene_.has(Effect::basal_friction))
     add_stage("basal_friction", [this] { apply_bed_friction_to_grid(); });
   if (scene_.has(Effect::lateral_walls)) {
@@ -410,6 +411,33 @@ void Simulation<Dim>::grid_velocity(const Vec<Dim>& gravity) {
       if (grid_.mass[f] > 0.0) grid_.vel[f] = grid_.vel[f] / grid_.mass[f] + dt * gravity;
     }
   });
+}
+
+template <int Dim>
+void Simulation<Dim>::drive_grid_nodes() {
+  // The piston acts on the grid too: each node's x-velocity is pulled towards the drive speed
+  // in proportion to the share of its mass that comes from the driven layer,
+  // v_x ← v_x + f (V − v_x), f = m_layer/m_node. Without it the layer, moved kinematically,
+  // overran the ice in front of it (the ice there moved at the grid's mass-averaged speed,
+  // ~0.94 vs 1.17 m/s at t = 15 s) and tore a full-depth crack a few cells ahead of the piston.
+  // The share varies smoothly as the layer moves, so no node switches on abruptly.
+  auto& P = particles_;
+  const double v = settling_ ? 0.0 : scene_.drive_velocity(time_);
+  const double inv_dx = 1.0 / scene_.dx;
+  drive_node_mass_.assign(grid_.node_count(), 0.0);
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    if (std::isnan(P.drive_x0[p])) continue;
+    const StencilWeights<Dim> w(P.x[p] * inv_dx);
+    const IVec<Dim> base = w.base();
+    for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
+      drive_node_mass_[grid_.flat(base + off)] += wt * P.mass[p];
+    });
+  }
+  for (std::size_t f = 0; f < drive_node_mass_.size(); ++f) {
+    if (drive_node_mass_[f] <= 0.0 || grid_.mass[f] <= 0.0) continue;
+    const double share = std::min(1.0, drive_node_mass_[f] / grid_.mass[f]);
+    grid_.vel[f][0] += share * (v - grid_.vel[f][0]);
+  }
 }
 
 template <int Dim>

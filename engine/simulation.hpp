@@ -82,6 +82,7 @@ class Simulation {
   void particle_to_grid();
   void grid_velocity(const Vec<Dim>& gravity);
   void drive_back_layer();
+  void drive_grid_nodes();
   void apply_bed_friction_to_grid();
   void apply_walls_to_grid(const std::vector<int>& axes, const Vec<Dim>& lo, const Vec<Dim>& hi);
   void apply_velocity_boxes_to_grid();
@@ -122,6 +123,7 @@ class Simulation {
   // Volume averaging scratch (reused every step): per-particle ΔJ̄/ΔJ, per-node averaged ΔJ.
   std::vector<double> volume_scale_;
   std::vector<double> grid_aux_;
+  std::vector<double> drive_node_mass_;  // per node: mass from the driven layer (drive_grid)
 
   Vec<Dim> domain_lo_, domain_hi_;
   double time_ = 0.0;

@@ -30,9 +30,10 @@ TEST(GlacierSmoke, IcePassesStepAndBreaksOnlyDownstream) {
 
   std::size_t damaged_upstream = 0, damaged_downstream = 0, upstream = 0, damaged_piston = 0;
   const double upstream_limit = scene.step_top_x() - scene.ice_thickness;  // one H_i behind the lip
-  // Known defect (docs/model.md, "Piston crack"): a full-depth crack opens a few cells ahead of
-  // the kinematic drive layer. The first H_i of ice behind the piston is therefore counted
-  // apart and reported, not asserted, until that boundary artefact is fixed.
+  // The piston's bottom corner (docs/model.md, "Piston"): where the driven layer meets the bed,
+  // a handful of particles still break (5 in this scene with engine 0.2.1; the full-depth
+  // crack of 0.2.0 is gone). The first H_i of ice behind the piston is therefore counted apart
+  // and bounded loosely, not asserted to be zero.
   const double back = *std::min_element(s.x.begin(), s.x.end());
   const double piston_zone = back + scene.ice_thickness;
   for (std::size_t i = 0; i < s.size(); ++i) {
@@ -48,6 +49,8 @@ TEST(GlacierSmoke, IcePassesStepAndBreaksOnlyDownstream) {
     }
   }
   RecordProperty("damaged_in_piston_zone", static_cast<int>(damaged_piston));
+  // A full-depth crack through the first cells would be ≥ H_i/h = 20 particles tall.
+  EXPECT_LT(damaged_piston, 20u) << "a crack through the ice behind the piston";
   ASSERT_GT(upstream, 40u);  // the slab upstream is still there to be checked (≥ one column)
   EXPECT_EQ(damaged_upstream, 0u) << "damage upstream of the step";
   EXPECT_GT(damaged_downstream, 50u) << "no damage at or past the step";
