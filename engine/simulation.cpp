@@ -378,27 +378,34 @@ void Simulation<Dim>::particle_to_grid() {
   const double dx = scene_.dx, inv_dx = 1.0 / dx;
   const double d_inv = 4.0 * inv_dx * inv_dx;  // MLS inertia-like tensor inverse for quadratic B-splines
   const double dt = dt_;
+  for_each_particle_coloured([&](std::uint32_t p) {
+    const Vec<Dim> xg = P.x[p] * inv_dx;
+    const StencilWeights<Dim> w(xg);
+    const IVec<Dim> base = w.base();
+    // MLS-MPM (Hu et al. 2018): stress enters as an affine momentum term,
+    // −dt·V0·τ·D⁻¹ with D⁻¹ = 4/dx² for quadratic B-splines.
+    const Mat<Dim> affine = P.mass[p] * P.C[p] - (dt * d_inv * P.vol0[p]) * P.tau[p];
+    const Vec<Dim> mv = P.mass[p] * P.v[p];
+    for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
+      const IVec<Dim> node = base + off;
+      const Vec<Dim> dpos = (node.template cast<double>() - xg) * dx;
+      const std::size_t f = grid_.flat(node);
+      grid_.mass[f] += wt * P.mass[p];
+      grid_.vel[f] += wt * (mv + affine * dpos);
+    });
+  });
+}
+
+template <int Dim>
+template <class Fn>
+void Simulation<Dim>::for_each_particle_coloured(Fn&& fn) {
+  // Race-free scatter: slabs of one parity share no grid node, so they run in parallel; the
+  // order inside a slab is fixed, so sums are deterministic whatever the thread count.
   const int slabs = static_cast<int>(slab_start_.size()) - 1;
   for (int colour = 0; colour < 2; ++colour) {
     tbb::parallel_for(0, (slabs + 1 - colour) / 2, [&](int half) {
       const int s = 2 * half + colour;
-      for (std::uint32_t q = slab_start_[s]; q < slab_start_[s + 1]; ++q) {
-        const std::uint32_t p = slab_order_[q];
-        const Vec<Dim> xg = P.x[p] * inv_dx;
-        const StencilWeights<Dim> w(xg);
-        const IVec<Dim> base = w.base();
-        // MLS-MPM (Hu et al. 2018): stress enters as an affine momentum term,
-        // −dt·V0·τ·D⁻¹ with D⁻¹ = 4/dx² for quadratic B-splines.
-        const Mat<Dim> affine = P.mass[p] * P.C[p] - (dt * d_inv * P.vol0[p]) * P.tau[p];
-        const Vec<Dim> mv = P.mass[p] * P.v[p];
-        for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
-          const IVec<Dim> node = base + off;
-          const Vec<Dim> dpos = (node.template cast<double>() - xg) * dx;
-          const std::size_t f = grid_.flat(node);
-          grid_.mass[f] += wt * P.mass[p];
-          grid_.vel[f] += wt * (mv + affine * dpos);
-        });
-      }
+      for (std::uint32_t q = slab_start_[s]; q < slab_start_[s + 1]; ++q) fn(slab_order_[q]);
     });
   }
 }
@@ -602,26 +609,29 @@ void Simulation<Dim>::average_volume_change() {
   const double zeta = plastic_.softening_zeta;
   volume_scale_.resize(n);
   grid_aux_.assign(2 * grid_.node_count(), 0.0);  // interleaved (Σ w m (1−D) ΔJ, Σ w m (1−D))
-  const int slabs = static_cast<int>(slab_start_.size()) - 1;
-  for (int colour = 0; colour < 2; ++colour) {
-    tbb::parallel_for(0, (slabs + 1 - colour) / 2, [&](int half) {
-      const int s = 2 * half + colour;
-      for (std::uint32_t q = slab_start_[s]; q < slab_start_[s + 1]; ++q) {
-        const std::uint32_t p = slab_order_[q];
-        const double dj = (Mat<Dim>::Identity() + dt_ * P.C[p]).determinant();
-        volume_scale_[p] = dj;
-        const double intact = damage ? std::exp(-zeta * P.eps_v_p[p]) : 1.0;
-        const double wm = P.mass[p] * intact;
-        const StencilWeights<Dim> w(P.x[p] * inv_dx);
-        const IVec<Dim> base = w.base();
-        for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
-          const std::size_t f = 2 * grid_.flat(base + off);
-          grid_aux_[f] += wt * wm * dj;
-          grid_aux_[f + 1] += wt * wm;
-        });
-      }
+  intact_.resize(n);
+  for_each_particle_coloured([&](std::uint32_t p) {
+    const double dj = (Mat<Dim>::Identity() + dt_ * P.C[p]).determinant();
+    volume_scale_[p] = dj;
+    intact_[p] = damage ? std::exp(-zeta * P.eps_v_p[p]) : 1.0;
+    const double wm = P.mass[p] * intact_[p];
+    const StencilWeights<Dim> w(P.x[p] * inv_dx);
+    const IVec<Dim> base = w.base();
+    for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
+      const std::size_t f = 2 * grid_.flat(base + off);
+      grid_aux_[f] += wt * wm * dj;
+      grid_aux_[f + 1] += wt * wm;
     });
-  }
+  });
+  // Per node, once: the averaged ΔJ and whether the node carries one (nodes reached only by
+  // (nearly) broken ice do not).
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid_.node_count(), kGrain), [&](const auto& r) {
+    for (std::size_t f = r.begin(); f != r.end(); ++f) {
+      const bool has = grid_aux_[2 * f + 1] > 1e-9 * grid_.mass[f];
+      grid_aux_[2 * f] = has ? grid_aux_[2 * f] / grid_aux_[2 * f + 1] : 0.0;
+      grid_aux_[2 * f + 1] = has ? 1.0 : 0.0;
+    }
+  });
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), [&](const auto& r) {
     for (std::size_t p = r.begin(); p != r.end(); ++p) {
       const StencilWeights<Dim> w(P.x[p] * inv_dx);
@@ -629,15 +639,11 @@ void Simulation<Dim>::average_volume_change() {
       double jbar = 0.0, wsum = 0.0;
       for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
         const std::size_t f = 2 * grid_.flat(base + off);
-        // Nodes reached only by (nearly) broken ice carry no average.
-        if (grid_aux_[f + 1] > 1e-9 * grid_.mass[f / 2]) {
-          jbar += wt * grid_aux_[f] / grid_aux_[f + 1];
-          wsum += wt;
-        }
+        jbar += wt * grid_aux_[f];
+        wsum += wt * grid_aux_[f + 1];
       });
       const double dj = volume_scale_[p];
-      const double intact = damage ? std::exp(-zeta * P.eps_v_p[p]) : 1.0;
-      const double used = wsum > 0.0 ? intact * (jbar / wsum) + (1.0 - intact) * dj : dj;
+      const double used = wsum > 0.0 ? intact_[p] * (jbar / wsum) + (1.0 - intact_[p]) * dj : dj;
       volume_scale_[p] = (dj > 0.0 && used > 0.0) ? used / dj : 1.0;
     }
   });

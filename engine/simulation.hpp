@@ -80,6 +80,8 @@ class Simulation {
   // Stages.
   void prepare_grid();
   void particle_to_grid();
+  template <class Fn>
+  void for_each_particle_coloured(Fn&& fn);  // race-free P2G-style traversal by x-slab parity
   void grid_velocity(const Vec<Dim>& gravity);
   void drive_back_layer();
   void drive_grid_nodes();
@@ -122,6 +124,7 @@ class Simulation {
   std::vector<std::uint32_t> slab_start_;
   // Volume averaging scratch (reused every step): per-particle ΔJ̄/ΔJ, per-node averaged ΔJ.
   std::vector<double> volume_scale_;
+  std::vector<double> intact_;  // e^{−ζ ε_v^p}, computed once per step for the averaging
   std::vector<double> grid_aux_;
   std::vector<double> drive_node_mass_;  // per node: mass from the driven layer (drive_grid)
 
