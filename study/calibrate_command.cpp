@@ -16,17 +16,12 @@
 namespace crevasse {
 namespace {
 
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.4g", v);
-  return buf;
-}
 
 std::string range(double lo, double hi) {
   std::string text = "[";
-  text += num(lo);
+  text += short_number(lo);
   text += ", ";
-  text += num(hi);
+  text += short_number(hi);
   return text + "]";
 }
 
@@ -71,12 +66,12 @@ QuantityLaws laws_from_records(const std::vector<FitRecord>& records) {
   }
   if (below && above && below->two_regimes.value_or(false) && below->breakpoint) {
     const double pi_star = *below->breakpoint;
-    out.model = "two regimes (broken line, Π* = " + num(pi_star) + " " +
+    out.model = "two regimes (broken line, Π* = " + short_number(pi_star) + " " +
                 range(below->breakpoint_lo.value_or(NAN), below->breakpoint_hi.value_or(NAN)) + ")";
-    out.regimes.push_back({"below Π* (Π < " + num(pi_star) + ")", below->x_min.value_or(NAN),
+    out.regimes.push_back({"below Π* (Π < " + short_number(pi_star) + ")", below->x_min.value_or(NAN),
                            pi_star, below->y_min.value_or(NAN), below->y_max.value_or(NAN),
                            below->law()});
-    out.regimes.push_back({"above Π* (Π ≥ " + num(pi_star) + ")", pi_star,
+    out.regimes.push_back({"above Π* (Π ≥ " + short_number(pi_star) + ")", pi_star,
                            above->x_max.value_or(NAN), above->y_min.value_or(NAN),
                            above->y_max.value_or(NAN), above->law()});
     return out;
@@ -140,12 +135,12 @@ StudyLaws load_laws(const std::string& db_path) {
 void print_header(const StudyLaws& laws, double level) {
   std::printf("%s\n  %s; %.0f %% intervals; ρ_i = %s kg/m³, g = %s m/s² as in the study\n",
               laws.title.c_str(), laws.source.c_str(), 100.0 * level,
-              num(laws.ice.density_kg_m3).c_str(), num(laws.ice.gravity_m_s2).c_str());
+              short_number(laws.ice.density_kg_m3).c_str(), short_number(laws.ice.gravity_m_s2).c_str());
   std::printf("  L_p/H_i: %s\n", laws.spacing.model.c_str());
 }
 
 std::string law_text(const char* symbol, const QuantityRegime& r) {
-  return std::string(symbol) + " = " + num(r.law.a()) + " Π^" + num(r.law.b) + " on Π in " +
+  return std::string(symbol) + " = " + short_number(r.law.a()) + " Π^" + short_number(r.law.b) + " on Π in " +
          range(r.pi_min, r.pi_max) + ", " + symbol + " in " + range(r.y_min, r.y_max);
 }
 
@@ -154,12 +149,12 @@ void note_thickness(const StudyLaws& laws, double h) {
     std::printf(
         "  note: H_i = %s m is outside the thicknesses the study ran (%s to %s m); the "
         "law is used through Π and L_p/H_i alone\n",
-        num(h).c_str(), num(laws.thickness_min).c_str(), num(laws.thickness_max).c_str());
+        short_number(h).c_str(), short_number(laws.thickness_min).c_str(), short_number(laws.thickness_max).c_str());
 }
 
 double positive(double v, const std::string& option) {
   if (!std::isfinite(v) || v <= 0.0)
-    throw InputError(option + ": must be a positive number, got " + num(v));
+    throw InputError(option + ": must be a positive number, got " + short_number(v));
   return v;
 }
 
@@ -167,7 +162,7 @@ double positive(double v, const std::string& option) {
 
 int calibrate_command(const CalibrateCommandOptions& opt) {
   if (!(opt.level > 0.5 && opt.level < 1.0))
-    throw InputError("--level: " + num(opt.level) + " is outside (0.5, 1)");
+    throw InputError("--level: " + short_number(opt.level) + " is outside (0.5, 1)");
   analysis::SpacingObservation obs;
   obs.spacing_m = positive(opt.spacing_m, "--spacing");
   if (opt.thickness_m) obs.thickness_m = positive(*opt.thickness_m, "--thickness");
@@ -189,8 +184,8 @@ int calibrate_command(const CalibrateCommandOptions& opt) {
       throw InputError("--spacing-quartiles: expected Q25,Q75 in metres, got '" +
                        opt.spacing_quartiles + "'");
     if (!(q25 > 0.0 && q25 <= obs.spacing_m && obs.spacing_m <= q75))
-      throw InputError("--spacing-quartiles: need 0 < Q25 <= spacing <= Q75, got " + num(q25) +
-                       " <= " + num(obs.spacing_m) + " <= " + num(q75));
+      throw InputError("--spacing-quartiles: need 0 < Q25 <= spacing <= Q75, got " + short_number(q25) +
+                       " <= " + short_number(obs.spacing_m) + " <= " + short_number(q75));
     obs.spacing_q25_m = q25;
     obs.spacing_q75_m = q75;
   }
@@ -227,12 +222,12 @@ int calibrate_command(const CalibrateCommandOptions& opt) {
   }
 
   print_header(laws, opt.level);
-  std::printf("observation: median spacing L_p = %s m", num(obs.spacing_m).c_str());
+  std::printf("observation: median spacing L_p = %s m", short_number(obs.spacing_m).c_str());
   if (obs.spacing_q25_m)
     std::printf(", quartiles %s m", range(*obs.spacing_q25_m, *obs.spacing_q75_m).c_str());
   if (obs.thickness_m)
-    std::printf(", H_i = %s m (L_p/H_i = %s)", num(*obs.thickness_m).c_str(),
-                num(obs.spacing_m / *obs.thickness_m).c_str());
+    std::printf(", H_i = %s m (L_p/H_i = %s)", short_number(*obs.thickness_m).c_str(),
+                short_number(obs.spacing_m / *obs.thickness_m).c_str());
   else
     std::printf(", thickness not given");
   std::printf("\n");
@@ -245,12 +240,12 @@ int calibrate_command(const CalibrateCommandOptions& opt) {
     }
     const analysis::CohesionEstimate& e = *answers[k].estimate;
     std::printf("  tensile strength c = %s Pa, %.0f %% interval %s Pa\n",
-                num(e.tensile_strength_pa).c_str(), 100.0 * e.level,
+                short_number(e.tensile_strength_pa).c_str(), 100.0 * e.level,
                 range(e.interval_pa.lower, e.interval_pa.upper).c_str());
     if (e.cohesion_ratio_pi) {
       const bool in = e.pi_in_regime_range.value_or(false);
       std::printf(
-          "  Π = %s %s: %s this regime's Π range %s%s\n", num(e.cohesion_ratio_pi->value).c_str(),
+          "  Π = %s %s: %s this regime's Π range %s%s\n", short_number(e.cohesion_ratio_pi->value).c_str(),
           range(e.cohesion_ratio_pi->interval.lower, e.cohesion_ratio_pi->interval.upper).c_str(),
           in ? "inside" : "OUTSIDE", range(r.pi_min, r.pi_max).c_str(),
           in ? (e.pi_interval_in_regime_range.value_or(false)
@@ -270,7 +265,7 @@ int calibrate_command(const CalibrateCommandOptions& opt) {
 
 int predict_command(const PredictCommandOptions& opt) {
   if (!(opt.level > 0.5 && opt.level < 1.0))
-    throw InputError("--level: " + num(opt.level) + " is outside (0.5, 1)");
+    throw InputError("--level: " + short_number(opt.level) + " is outside (0.5, 1)");
   positive(opt.tensile_strength_pa, "--cohesion");
   positive(opt.thickness_m, "--thickness");
   const StudyLaws laws = load_laws(opt.db_path);
@@ -279,7 +274,7 @@ int predict_command(const PredictCommandOptions& opt) {
   const auto& spacing = laws.spacing.regimes;
   const auto s = std::find_if(spacing.begin(), spacing.end(), holds);
   if (s == spacing.end())
-    throw InputError("--cohesion/--thickness: Π = c/(ρ_i g H_i) = " + num(pi) +
+    throw InputError("--cohesion/--thickness: Π = c/(ρ_i g H_i) = " + short_number(pi) +
                      " lies outside the Π range the study covered, " +
                      range(spacing.front().pi_min, spacing.back().pi_max) +
                      "; the laws are not extrapolated");
@@ -294,21 +289,21 @@ int predict_command(const PredictCommandOptions& opt) {
       analysis::predict_crevasses(regime, opt.tensile_strength_pa, opt.thickness_m, options);
 
   print_header(laws, opt.level);
-  std::printf("c = %s Pa, H_i = %s m: Π = %s, regime %s\n", num(opt.tensile_strength_pa).c_str(),
-              num(opt.thickness_m).c_str(), num(pi).c_str(), s->name.c_str());
+  std::printf("c = %s Pa, H_i = %s m: Π = %s, regime %s\n", short_number(opt.tensile_strength_pa).c_str(),
+              short_number(opt.thickness_m).c_str(), short_number(pi).c_str(), s->name.c_str());
   std::printf("  %s\n", law_text("L_p/H_i", *s).c_str());
   std::printf("  median spacing L_p = %s m: the law's %.0f %% band %s m, one site %s m\n",
-              num(p.spacing_m.value).c_str(), 100.0 * opt.level,
+              short_number(p.spacing_m.value).c_str(), 100.0 * opt.level,
               range(p.spacing_m.interval.lower, p.spacing_m.interval.upper).c_str(),
               range(p.spacing_prediction_m.lower, p.spacing_prediction_m.upper).c_str());
   if (p.depth_m) {
     std::printf("  %s\n", law_text("D_p/H_i", *d).c_str());
     std::printf("  median depth D_p = %s m: the law's %.0f %% band %s m, one site %s m\n",
-                num(p.depth_m->value).c_str(), 100.0 * opt.level,
+                short_number(p.depth_m->value).c_str(), 100.0 * opt.level,
                 range(p.depth_m->interval.lower, p.depth_m->interval.upper).c_str(),
                 range(p.depth_prediction_m->lower, p.depth_prediction_m->upper).c_str());
   } else {
-    std::printf("  depth: no law of D_p/H_i covers Π = %s (%s)\n", num(pi).c_str(),
+    std::printf("  depth: no law of D_p/H_i covers Π = %s (%s)\n", short_number(pi).c_str(),
                 depth.empty() ? laws.depth.problem.c_str() : "outside its Π range");
   }
   note_thickness(laws, opt.thickness_m);

@@ -9,13 +9,14 @@
 #include "engine/error.hpp"
 
 namespace crevasse {
-namespace {
 
-std::string number(double v) {
+std::string short_number(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.4g", v);
   return buf;
 }
+
+namespace {
 
 std::optional<double> parse_exponent(const std::string& text, const std::string& option) {
   if (text == "free" || text == "-" || text.empty()) return std::nullopt;
@@ -84,7 +85,7 @@ StudyFit fit_study(const std::vector<CaseRecord>& cases, Quantity quantity, cons
         std::to_string(fit.x.size()) + " case(s) with a value, a power law needs 3";
   } else if (distinct.size() < 2) {
     fit.single_problem = "all " + std::to_string(fit.x.size()) + " cases have " + group.name +
-                         " = " + number(fit.x.front()) + " (the group does not vary)";
+                         " = " + short_number(fit.x.front()) + " (the group does not vary)";
   } else {
     try {
       fit.single = analysis::fit_power_law(fit.x, fit.y, options.level);
@@ -126,7 +127,7 @@ void parse_fixed_exponents(const std::string& text, const std::string& option,
 
 std::string fixed_exponents_text(const StudyFitOptions& options) {
   if (!options.fixed_b1 && !options.fixed_b2) return {};
-  const auto one = [](const std::optional<double>& b) { return b ? number(*b) : "free"; };
+  const auto one = [](const std::optional<double>& b) { return b ? short_number(*b) : "free"; };
   return one(options.fixed_b1) + "," + one(options.fixed_b2);
 }
 

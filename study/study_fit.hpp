@@ -14,6 +14,10 @@
 
 namespace crevasse {
 
+// A number for messages and tables: %.4g.
+std::string short_number(double v);
+
+
 struct StudyFitOptions {
   double level = 0.95;
   // Exponents of the broken line's segments held at a value (below, above Π*); empty = free.
