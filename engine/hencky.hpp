@@ -32,17 +32,82 @@ struct PrincipalStretch {
   Vec<Dim> eps;        // principal Hencky strains ε_i = ½ log(eigenvalue_i of b)
 };
 
-// Principal frame and Hencky strains of F. Solving for b − I keeps relative precision at the
-// small strains of ice (|ε| ~ 1e-3), and log1p keeps it in the logarithm.
+namespace detail {
+
+// Below this spread of the eigenvalues of b − I (|λ₁ − λ₀|/2) the 2D closed form takes U = I.
+// b − I is O(1) or smaller for ice, so the tensor it leaves out (at most 2e-150 in any entry)
+// is far below the round-off of any entry of F; the bound only keeps r² and |v|² clear of
+// underflow (r² > 1e-300 > the smallest normal double, 2.2e-308).
+inline constexpr double kIsotropicSpread2 = 1e-150;
+
+// 2D closed form (plane strain, F is 2×2). With H = F − I (exact for the entries of a
+// deformation gradient near I), b − I = H + Hᵀ + H Hᵀ is formed entry by entry as
+//   (b − I)₀₀ = H₀₀(2 + H₀₀) + F₀₁²,  (b − I)₁₁ = H₁₁(2 + H₁₁) + F₁₀²,  (b − I)₀₁ = F₀₀F₁₀ + F₀₁F₁₁,
+// which keeps relative precision however small the strain (F Fᵀ − I loses digits to the 1).
+// Eigenvalues of [[a, d], [d, c]]: m ± r with m = (a + c)/2, h = (a − c)/2, r = sqrt(h² + d²).
+// The larger one's Hencky strain is ε₁ = ½ log1p(m + r); the other comes from the volume,
+// ε₀ = log|det F| − ε₁ with det F − 1 = H₀₀ + H₁₁ + H₀₀H₁₁ − F₀₁F₁₀, which stays accurate when
+// F is nearly singular (1 + λ₀ = σ₀² would lose everything below 1e-16) and makes
+// ε₀ + ε₁ = log|det F| to round-off. The eigenvector of m + r is (h + r, d) when h ≥ 0 and
+// (d, r − h) otherwise: both are exact null vectors of b − I − (m + r) I, and their length is at
+// least r, so normalising cancels nothing. The other column is its rotation by −90°, so U is a
+// proper rotation (det U = +1) and orthonormal to round-off; columns in ascending order of
+// eigenvalue, as Eigen's solver returns them.
+inline PrincipalStretch<2> principal_hencky_2d(const Mat<2>& F) {
+  const double f00 = F(0, 0), f01 = F(0, 1), f10 = F(1, 0), f11 = F(1, 1);
+  const double h00 = f00 - 1.0, h11 = f11 - 1.0;
+  const double a = h00 * (2.0 + h00) + f01 * f01;
+  const double c = h11 * (2.0 + h11) + f10 * f10;
+  const double d = f00 * f10 + f01 * f11;
+  const double m = 0.5 * (a + c);
+  const double h = 0.5 * (a - c);
+  const double r = std::sqrt(h * h + d * d);
+  double j_minus_1 = h00 + h11 + (h00 * h11 - f01 * f10);
+  if (j_minus_1 < -1.0) j_minus_1 = -2.0 - j_minus_1;  // det F < 0: |det F| − 1
+  PrincipalStretch<2> out;
+  out.eps[1] = 0.5 * std::log1p(m + r);
+  out.eps[0] = std::log1p(j_minus_1) - out.eps[1];
+  if (r > kIsotropicSpread2) {
+    double vx, vy;
+    if (h >= 0.0) {
+      vx = h + r;
+      vy = d;
+    } else {
+      vx = d;
+      vy = r - h;
+    }
+    const double inv = 1.0 / std::sqrt(vx * vx + vy * vy);
+    vx *= inv;
+    vy *= inv;
+    out.U(0, 0) = vy;
+    out.U(1, 0) = -vx;
+    out.U(0, 1) = vx;
+    out.U(1, 1) = vy;
+  } else {
+    out.U.setIdentity();
+  }
+  return out;
+}
+
+}  // namespace detail
+
+// Principal frame and Hencky strains of F, ε in ascending order (U's columns match). Solving
+// for b − I keeps relative precision at the small strains of ice (|ε| ~ 1e-3), and log1p keeps
+// it in the logarithm. 2D: the closed form above, inlined (tests/engine/test_principal_hencky.cpp
+// checks it against Eigen and a long-double reference); 3D: Eigen's direct solver.
 template <int Dim>
 inline PrincipalStretch<Dim> principal_hencky(const Mat<Dim>& F) {
-  const Mat<Dim> b_minus_i = F * F.transpose() - Mat<Dim>::Identity();
-  Eigen::SelfAdjointEigenSolver<Mat<Dim>> eig;
-  eig.computeDirect(b_minus_i);
-  PrincipalStretch<Dim> out;
-  out.U = eig.eigenvectors();
-  for (int a = 0; a < Dim; ++a) out.eps[a] = 0.5 * std::log1p(eig.eigenvalues()[a]);
-  return out;
+  if constexpr (Dim == 2) {
+    return detail::principal_hencky_2d(F);
+  } else {
+    const Mat<Dim> b_minus_i = F * F.transpose() - Mat<Dim>::Identity();
+    Eigen::SelfAdjointEigenSolver<Mat<Dim>> eig;
+    eig.computeDirect(b_minus_i);
+    PrincipalStretch<Dim> out;
+    out.U = eig.eigenvectors();
+    for (int a = 0; a < Dim; ++a) out.eps[a] = 0.5 * std::log1p(eig.eigenvalues()[a]);
+    return out;
+  }
 }
 
 template <int Dim>
@@ -50,9 +115,24 @@ inline Vec<Dim> principal_kirchhoff(const ElasticModuli& m, const Vec<Dim>& eps)
   return (2.0 * m.mu * eps.array() + m.lambda * eps.sum()).matrix();
 }
 
+// τ = U diag(τ_i) Uᵀ. In 2D, with u = U's second column, U diag(τ₀, τ₁) Uᵀ = τ₀ I + (τ₁ − τ₀) u uᵀ
+// (U orthonormal), which is exactly symmetric and needs 4 products instead of a 2×2×2 chain.
 template <int Dim>
 inline Mat<Dim> kirchhoff_stress(const ElasticModuli& m, const PrincipalStretch<Dim>& s) {
-  return s.U * principal_kirchhoff<Dim>(m, s.eps).asDiagonal() * s.U.transpose();
+  if constexpr (Dim == 2) {
+    const Vec<2> t = principal_kirchhoff<2>(m, s.eps);
+    const double ux = s.U(0, 1), uy = s.U(1, 1);
+    const double dt = t[1] - t[0];
+    const double off = dt * ux * uy;
+    Mat<2> tau;
+    tau(0, 0) = t[0] + dt * ux * ux;
+    tau(1, 1) = t[0] + dt * uy * uy;
+    tau(0, 1) = off;
+    tau(1, 0) = off;
+    return tau;
+  } else {
+    return s.U * principal_kirchhoff<Dim>(m, s.eps).asDiagonal() * s.U.transpose();
+  }
 }
 
 // Principal Hencky strains that produce a given principal Kirchhoff stress (the inverse law),

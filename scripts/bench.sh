@@ -5,9 +5,10 @@
 # shared machine are noisy: the load average before and after is printed with the table.
 #   BENCH_FILTER=regex   run only the matching cases (Google Benchmark --benchmark_filter)
 #   BENCH_JOBS=N         build jobs (1)
+#   BENCH_BUILD_DIR=DIR  build directory (build-bench), e.g. to keep a separate tree per session
 set -euo pipefail
 cd "$(dirname "$0")/.."
-build=build-bench
+build=${BENCH_BUILD_DIR:-build-bench}
 reps=${BENCH_REPETITIONS:-5}
 filter=${BENCH_FILTER:-.}
 command -v python3 >/dev/null || { echo "bench.sh: python3 is needed to print the table" >&2; exit 1; }
