@@ -44,6 +44,56 @@ inline SceneConfig box_scene(int dim, std::array<double, 3> lo, std::array<doubl
   return s;
 }
 
+// A small glacier pushed over a step: the scene of studies/scenes/glacier_2d.json (effects
+// gravity, drive, basal_friction, plasticity, softening, outflow; lateral_walls in 3D;
+// geostatic start; ζ from the crack-band reference) on a coarse grid (by default the coarsest
+// the validation allows, dx = H_i/4) and a short domain, so that a run takes seconds. Lengths are in units of H_i;
+// the tensile strength is given as Π = c/(ρ_i g H_i).
+struct SmallGlacier {
+  int dim = 2;
+  double thickness = 50.0;          // H_i [m]
+  double step_height_ratio = 1.0;   // H_s/H_i
+  double step_length_ratio = 1.0;   // L_s/H_i (0: vertical step; slope = H_s/L_s)
+  double upstream_ratio = 3.0;      // slab length on the plateau / H_i
+  double downstream_ratio = 4.0;    // floor past the step / H_i
+  double width_ratio = 1.0;         // W_i/H_i (3D)
+  double cohesion_ratio = 0.2;      // Π
+  double drive_speed = 4.0;         // V_x [m/s]
+  double cells_per_thickness = 4.0;  // H_i/dx (≥ 4)
+  double cfl = 0.5;
+  double end_time = 60.0;           // [s]
+};
+
+inline SceneConfig small_glacier_scene(const SmallGlacier& g) {
+  SceneConfig s;
+  s.name = "small_glacier";
+  s.dim = g.dim;
+  s.effects = {Effect::gravity, Effect::drive, Effect::basal_friction, Effect::plasticity,
+               Effect::softening, Effect::outflow};
+  if (g.dim == 3) s.effects.push_back(Effect::lateral_walls);
+  s.body = "slab";
+  s.initial_stress = "geostatic";
+  s.density = kRho;
+  s.youngs_modulus = kYoung;
+  s.poisson_ratio = kPoisson;
+  s.gravity = kG;
+  s.ice_thickness = g.thickness;
+  s.upstream_length = g.upstream_ratio * g.thickness;
+  s.width = g.width_ratio * g.thickness;
+  s.tensile_strength = g.cohesion_ratio * kRho * kG * g.thickness;
+  s.bed_shape = "step";
+  s.step_height = g.step_height_ratio * g.thickness;
+  s.step_length = g.step_length_ratio * g.thickness;
+  s.downstream_length = g.downstream_ratio * g.thickness;
+  s.drive_speed = g.drive_speed;
+  s.dx = g.thickness / g.cells_per_thickness;
+  s.cfl = g.cfl;
+  s.end_time = g.end_time;
+  s.png = false;
+  s.resolve();
+  return s;
+}
+
 inline SceneConfig finish(SceneConfig s) {
   s.resolve();
   return s;
