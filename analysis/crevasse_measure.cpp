@@ -73,8 +73,53 @@ struct Candidate {
 
 }  // namespace
 
-ResolvedMeasureSettings resolve_measure_settings(const ParticleSnapshot& snapshot,
-                                                 const MeasureSettings& settings) {
+bool uses_gate_frame(const ParticleSnapshot& snapshot, const MeasureSettings& settings) {
+  require(settings.frame == "auto" || settings.frame == "gate" || settings.frame == "final",
+          "frame must be 'auto', 'gate' or 'final', got '" + settings.frame + "'");
+  if (settings.frame == "gate")
+    require(snapshot.has_gate(), "frame 'gate' needs a snapshot with gate records (a slab on a "
+                                 "step or concave bed, with plasticity)");
+  return settings.frame == "gate" || (settings.frame == "auto" && snapshot.has_gate());
+}
+
+ParticleSnapshot gate_frame_snapshot(const ParticleSnapshot& s) {
+  require(s.has_gate(), "the snapshot has no gate records");
+  const std::size_t n = s.gate_eps_v_p.size();
+  require(s.gate_x_ref.size() == n && s.gate_z_ref.size() == n &&
+              (s.dim == 2 || s.gate_y_ref.size() == n),
+          "the snapshot's gate record arrays differ in length");
+  ParticleSnapshot g;
+  g.dim = s.dim;
+  g.time_s = s.time_s;
+  g.dx_m = s.dx_m;
+  g.softening_zeta = s.softening_zeta;
+  g.tensile_strength_pa = s.tensile_strength_pa;
+  g.ice_thickness_m = s.ice_thickness_m;
+  g.step_top_x_m = s.step_top_x_m;
+  g.step_foot_x_m = s.step_foot_x_m;
+  g.particle_spacing_m = s.particle_spacing_m;
+  g.bed_profile = s.bed_profile;
+  g.gate_x_m = s.gate_x_m;
+  g.gate_passed_length_m = s.gate_passed_length_m;
+  g.ice_front_x_m = s.gate_x_m;
+  g.x = s.gate_x_ref;
+  g.z = s.gate_z_ref;
+  if (s.dim == 3) g.y = s.gate_y_ref;
+  g.eps_v_p = s.gate_eps_v_p;
+  g.vx.assign(n, 0.0);
+  g.vz.assign(n, 0.0);
+  if (s.dim == 3) g.vy.assign(n, 0.0);
+  g.pressure_pa.assign(n, 0.0);
+  g.von_mises_pa.assign(n, 0.0);
+  g.sigma_zz_pa.assign(n, 0.0);
+  g.volume_m3.assign(n, 0.0);
+  return g;
+}
+
+namespace {
+
+ResolvedMeasureSettings resolve_in_frame(const ParticleSnapshot& snapshot,
+                                         const MeasureSettings& settings, bool gate) {
   check_arrays(snapshot);
   const bool has_particles = snapshot.size() > 0;
   ResolvedMeasureSettings r;
@@ -125,8 +170,15 @@ ResolvedMeasureSettings resolve_measure_settings(const ParticleSnapshot& snapsho
 
   const double margin = settings.window_margin_over_h * r.ice_thickness_m;
   r.window_explicit = settings.window_min_x_m.has_value() || settings.window_max_x_m.has_value();
-  r.window_min_x_m = settings.window_min_x_m.value_or(snapshot.step_foot_x_m + margin);
-  r.window_max_x_m = settings.window_max_x_m.value_or(snapshot.front_x() - margin);
+  r.frame = gate ? "gate" : "final";
+  if (gate) {
+    r.window_min_x_m =
+        settings.window_min_x_m.value_or(snapshot.gate_x_m - snapshot.gate_passed_length_m + margin);
+    r.window_max_x_m = settings.window_max_x_m.value_or(snapshot.gate_x_m - margin);
+  } else {
+    r.window_min_x_m = settings.window_min_x_m.value_or(snapshot.step_foot_x_m + margin);
+    r.window_max_x_m = settings.window_max_x_m.value_or(snapshot.front_x() - margin);
+  }
   require(std::isfinite(r.window_min_x_m) && std::isfinite(r.window_max_x_m),
           "window bounds must be finite");
 
@@ -143,10 +195,31 @@ ResolvedMeasureSettings resolve_measure_settings(const ParticleSnapshot& snapsho
   return r;
 }
 
+CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
+                                     const MeasureSettings& settings, bool gate);
+
+}  // namespace
+
+ResolvedMeasureSettings resolve_measure_settings(const ParticleSnapshot& snapshot,
+                                                 const MeasureSettings& settings) {
+  if (uses_gate_frame(snapshot, settings))
+    return resolve_in_frame(gate_frame_snapshot(snapshot), settings, true);
+  return resolve_in_frame(snapshot, settings, false);
+}
+
 CrevasseMeasurement measure_crevasses(const ParticleSnapshot& snapshot,
                                       const MeasureSettings& settings) {
+  if (uses_gate_frame(snapshot, settings))
+    return measure_in_frame(gate_frame_snapshot(snapshot), settings, true);
+  return measure_in_frame(snapshot, settings, false);
+}
+
+namespace {
+
+CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
+                                     const MeasureSettings& settings, bool gate) {
   CrevasseMeasurement m;
-  m.settings = resolve_measure_settings(snapshot, settings);
+  m.settings = resolve_in_frame(snapshot, settings, gate);
   m.time_s = snapshot.time_s;
   const ResolvedMeasureSettings& r = m.settings;
   const DamageCriterion criterion = DamageCriterion::for_snapshot(
@@ -298,5 +371,7 @@ CrevasseMeasurement measure_crevasses(const ParticleSnapshot& snapshot,
   }
   return m;
 }
+
+}  // namespace
 
 }  // namespace crevasse::analysis

@@ -3,6 +3,7 @@
 // research_physics.md §4). Definitions and the reasons for each default: docs/measurement.md.
 #include <cstddef>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "analysis/surface_profile.hpp"
@@ -19,8 +20,19 @@ struct MeasureSettings {
   // Used instead when the snapshot has no softening (ζ = 0): damaged ⇔ ε_v^p ≥ this.
   double eps_v_p_threshold = 0.01;
 
-  // Window along flow: [step_foot_x + margin·H_i, front − margin·H_i] unless given. The margins
+  // Which particle field is measured (docs/measurement.md, "Gate frame"):
+  //   "gate":  the damage each particle carried when it reached the top of the step, drawn at
+  //            its initial position — the fracture pattern the ice took over the step, before
+  //            falling blocks shatter on the floor. Needs a snapshot with gate records.
+  //   "final": the particles where they are at the snapshot's time (SPEC §5 as written).
+  //   "auto":  "gate" when the snapshot has gate records, else "final".
+  std::string frame = "auto";
+
+  // Window along flow. Final frame: [step_foot_x + margin·H_i, front − margin·H_i]; the margins
   // keep out the step's own bending zone and the front, whose free face cracks differently.
+  // Gate frame (initial positions): [gate_x − passed + margin·H_i, gate_x − margin·H_i], i.e.
+  // the ice that has passed the gate less its first margin·H_i (the initial front's own face)
+  // and its last (only partly through). Explicit bounds are in the frame's coordinates.
   std::optional<double> window_min_x_m;
   std::optional<double> window_max_x_m;
   double window_margin_over_h = 0.5;
@@ -56,6 +68,7 @@ struct MeasureSettings {
 
 // The numbers actually used, recorded with every result.
 struct ResolvedMeasureSettings {
+  std::string frame = "final";  // "gate" or "final"
   double damage_threshold = 0.0;
   double eps_v_p_threshold = 0.0;         // the ε_v^p at which a particle becomes damaged
   bool threshold_from_softening = false;  // false: the absolute ε_v^p threshold was used
@@ -127,5 +140,13 @@ ResolvedMeasureSettings resolve_measure_settings(const ParticleSnapshot& snapsho
                                                  const MeasureSettings& settings);
 CrevasseMeasurement measure_crevasses(const ParticleSnapshot& snapshot,
                                       const MeasureSettings& settings = {});
+
+// The gate records of a snapshot as a snapshot of their own: each recorded particle at its
+// initial position with the ε_v^p it had at the gate (velocities and stresses zero). Metadata
+// (dx, H_i, ζ, bed, gate) copied; the front is the gate. Throws when there are no records.
+ParticleSnapshot gate_frame_snapshot(const ParticleSnapshot& snapshot);
+// True when `settings` select the gate frame for this snapshot (throws on a bad frame name or
+// on "gate" without gate records).
+bool uses_gate_frame(const ParticleSnapshot& snapshot, const MeasureSettings& settings);
 
 }  // namespace crevasse::analysis

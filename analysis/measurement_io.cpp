@@ -52,6 +52,7 @@ void write_crevasses_csv(const CrevasseMeasurement& m, const std::filesystem::pa
 
 nlohmann::json settings_to_json(const ResolvedMeasureSettings& s) {
   nlohmann::json j = {
+      {"frame", s.frame},
       {"damage_threshold", s.damage_threshold},
       {"eps_v_p_threshold", s.eps_v_p_threshold},
       {"threshold_from_softening", s.threshold_from_softening},

@@ -184,6 +184,19 @@ void draw_axes(cairo_t* cr, const Frame& f) {
 }
 
 void draw_marks(cairo_t* cr, const Frame& f, const CrevasseMeasurement& m) {
+  // The measurement window: two grey dashed verticals over the whole height.
+  cairo_set_source_rgb(cr, 0.45, 0.45, 0.45);
+  cairo_set_line_width(cr, 1.0);
+  const double window_dash[] = {6.0, 4.0};
+  cairo_set_dash(cr, window_dash, 2, 0.0);
+  for (double x : {m.settings.window_min_x_m, m.settings.window_max_x_m}) {
+    const double p = std::round(f.px(x)) + 0.5;
+    if (p < f.left_px || p > f.left_px + f.width_px) continue;
+    cairo_move_to(cr, p, f.top_px);
+    cairo_line_to(cr, p, f.top_px + f.height_px);
+    cairo_stroke(cr);
+  }
+  cairo_set_dash(cr, nullptr, 0, 0.0);
   if (m.crevasses.empty()) return;
   double min_gap_px = 1e9;
   for (std::size_t i = 1; i < m.crevasses.size(); ++i) {

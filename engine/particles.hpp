@@ -2,6 +2,7 @@
 // Particle state as structure of arrays. Hot fields of the step (x, v, C, F_E, τ, mass, V0)
 // are always present; ε_v^p is allocated only when the scene names plasticity, so an elastic
 // scene carries no plastic storage (SPEC §4).
+#include <array>
 #include <cstdint>
 #include <numeric>
 #include <vector>
@@ -23,6 +24,11 @@ struct Particles {
   // Drive: initial x of the particles of the pushed back layer, NaN for the others; empty
   // without the drive effect.
   std::vector<double> drive_x0;
+  // Measurement gate (docs/measurement.md, "Gate frame"): each particle's initial position and
+  // its ε_v^p when it first reached the gate, −1 before. Floats (12 B per particle in 2D): the
+  // positions are only binned at dx and the damage only thresholded. Empty without a gate.
+  std::vector<std::array<float, Dim>> x_ref;
+  std::vector<float> gate_eps;
 
   std::size_t size() const { return x.size(); }
   bool has_plastic_state() const { return !eps_v_p.empty(); }
@@ -43,6 +49,7 @@ struct Particles {
     apply(mass, order); apply(vol0, order);
     if (has_plastic_state()) apply(eps_v_p, order);
     if (!drive_x0.empty()) apply(drive_x0, order);
+    if (!x_ref.empty()) { apply(x_ref, order); apply(gate_eps, order); }
   }
 
   // Keeps the particles with keep[i] true, in order; returns the mass removed.

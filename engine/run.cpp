@@ -27,6 +27,7 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
     if (scene.end_time > 0) f = std::max(f, sim.time() / scene.end_time);
     if (scene.front_past_step > 0 && target_front > front0)
       f = std::max(f, (ice_front - front0) / (target_front - front0));
+    if (scene.gate_length > 0) f = std::max(f, sim.gate_passed_length() / scene.gate_length);
     if (scene.max_steps > 0) f = std::max(f, static_cast<double>(sim.steps()) / scene.max_steps);
     return std::clamp(f, 0.0, 1.0);
   };
@@ -50,6 +51,7 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
     if (scene.end_time > 0 && sim.time() >= scene.end_time) { out.stop_reason = "end_time"; break; }
     if (sim.steps() % 20 == 0) ice_front = sim.ice_front_x();
     if (scene.front_past_step > 0 && ice_front >= target_front) { out.stop_reason = "front_past_step"; break; }
+    if (scene.gate_length > 0 && sim.gate_passed_length() >= scene.gate_length) { out.stop_reason = "gate_length"; break; }
     if (scene.max_steps > 0 && sim.steps() >= scene.max_steps) { out.stop_reason = "max_steps"; break; }
     if (sim.particles().size() == 0) { out.stop_reason = "no_ice_left"; break; }
     sim.step();

@@ -35,7 +35,7 @@ class RunObserver {
 };
 
 struct RunSummary {
-  std::string stop_reason;  // "front_past_step", "end_time", "max_steps", "cancelled"
+  std::string stop_reason;  // "front_past_step", "gate_length", "end_time", "max_steps", "cancelled", "no_ice_left"
   std::int64_t steps = 0;
   std::int64_t particle_steps = 0;
   std::int64_t return_map_evaluations = 0;

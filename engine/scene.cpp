@@ -126,6 +126,10 @@ Effect effect_from_name(const std::string& name) {
   fail("effects", "unknown effect '" + name + "' (allowed: " + all + ")");
 }
 
+bool SceneConfig::records_gate() const {
+  return body == "slab" && (bed_shape == "step" || bed_shape == "concave") && has(Effect::plasticity);
+}
+
 bool SceneConfig::has(Effect e) const {
   return std::find(effects.begin(), effects.end(), e) != effects.end();
 }
@@ -181,8 +185,8 @@ void SceneConfig::resolve() {
   check_range("run.wall_time_limit", wall_time_limit, 0.0, 1e9);
   check_range("output.vtu_interval", vtu_interval, 0.0, 1e9);
   if (max_steps < 0) fail("run.max_steps", "must be ≥ 0 (0 = unlimited)");
-  if (end_time == 0 && front_past_step == 0 && max_steps == 0)
-    fail("run", "give end_time, front_past_step or max_steps, or the run never stops");
+  if (end_time == 0 && front_past_step == 0 && gate_length == 0 && max_steps == 0)
+    fail("run", "give end_time, front_past_step, gate_length or max_steps, or the run never stops");
   if (has(Effect::softening) && !has(Effect::plasticity))
     fail("effects", "'softening' needs 'plasticity'");
   if (initial_stress != "geostatic" && initial_stress != "none")
@@ -248,6 +252,12 @@ void SceneConfig::resolve() {
       fail("bed.shape", "value '" + bed_shape + "' is not 'flat' or 'none' (body 'box')");
   } else {
     fail("ice.body", "value '" + body + "' is not 'slab' or 'box'");
+  }
+  check_range("run.gate_length", gate_length, 0.0, 1e9);
+  if (gate_length != 0.0) {
+    if (!records_gate())
+      fail("run.gate_length", "needs a slab on a 'step' or 'concave' bed with the 'plasticity' effect");
+    check_range("run.gate_length", gate_length, 0.0, upstream_length, true);
   }
   if (has(Effect::basal_friction) && bed_shape == "none")
     fail("bed.shape", "'basal_friction' needs a bed");
@@ -386,6 +396,7 @@ SceneConfig scene_from_json(const nlohmann::json& j) {
     ObjectReader o(*run, "run");
     o.number("end_time", s.end_time);
     o.number("front_past_step", s.front_past_step);
+    o.number("gate_length", s.gate_length);
     o.integer("max_steps", s.max_steps);
     o.number("wall_time_limit", s.wall_time_limit);
     o.refuse_unknown();
@@ -454,6 +465,7 @@ nlohmann::json scene_to_json(const SceneConfig& s) {
       {"run",
        {{"end_time", s.end_time},
         {"front_past_step", s.front_past_step},
+        {"gate_length", s.gate_length},
         {"max_steps", s.max_steps},
         {"wall_time_limit", s.wall_time_limit}}},
       {"output", {{"vtu_interval", s.vtu_interval}, {"png", s.png}}},

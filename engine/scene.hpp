@@ -104,6 +104,9 @@ struct SceneConfig {
   // Run control
   double end_time = 0.0;              // [s]; 0 → until front_past_step
   double front_past_step = 0.0;       // stop when the front is this far past the step foot [m]
+  // Stop once this much ice, as a length along flow, has passed the measurement gate at the top
+  // of the step [m]; 0 = off. Only for a slab on a step or concave bed with plasticity.
+  double gate_length = 0.0;
   std::int64_t max_steps = 0;         // 0 = unlimited
   double wall_time_limit = 0.0;       // [s]; 0 = unlimited
 
@@ -117,6 +120,10 @@ struct SceneConfig {
   void resolve();
   // Derived quantities (valid after resolve()).
   double step_top_x() const { return upstream_length; }
+  // The measurement gate records damage as the ice reaches the top of the step: for a slab on
+  // a step or concave bed, with plasticity (docs/measurement.md, "Gate frame").
+  bool records_gate() const;
+  double gate_x() const { return step_top_x(); }
   double step_foot_x() const { return upstream_length + step_length; }
   double p_wave_speed() const;
   double drive_velocity(double t) const;  // piston speed at time t [m/s]

@@ -65,6 +65,7 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   }
   if (bed_) build_bed_table();
   seed_particles();
+  if (scene_.records_gate()) init_gate();
 
   // Assemble the step from the scene's effects (SPEC §4).
   const double g = scene_.has(Effect::gravity) ? scene_.gravity : 0.0;
@@ -130,6 +131,7 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   add_stage("domain_clamp", [this] {
     for (int a = 0; a < Dim; ++a) clamp_particles(a, domain_lo_[a], domain_hi_[a]);
   });
+  if (scene_.records_gate()) add_stage("gate", [this] { record_gate(); });
   if (scene_.has(Effect::outflow)) add_stage("outflow", [this] { remove_outflow(); });
   add_stage("time_step", [this] { update_time_step(); });
 
@@ -698,7 +700,46 @@ void Simulation<Dim>::remove_outflow() {
     keep[p] = P.x[p][0] < x_out;
     any |= !keep[p];
   }
-  if (any) removed_mass_ += P.compact(keep);
+  if (!any) return;
+  if (records_gate()) {
+    for (std::size_t p = 0; p < P.size(); ++p) {
+      if (keep[p] || P.gate_eps[p] < 0.0f) continue;
+      gate_archive_x_.push_back(P.x_ref[p]);
+      gate_archive_eps_.push_back(P.gate_eps[p]);
+    }
+  }
+  removed_mass_ += P.compact(keep);
+}
+
+template <int Dim>
+void Simulation<Dim>::init_gate() {
+  auto& P = particles_;
+  const double gx = scene_.gate_x();
+  P.x_ref.resize(P.size());
+  P.gate_eps.assign(P.size(), -1.0f);
+  double upstream_volume = 0.0;
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    for (int a = 0; a < Dim; ++a) P.x_ref[p][a] = static_cast<float>(P.x[p][a]);
+    if (P.x[p][0] < gx) upstream_volume += P.vol0[p];
+  }
+  gate_cross_section_ = upstream_volume > 0.0 ? upstream_volume / scene_.upstream_length : 1.0;
+}
+
+template <int Dim>
+void Simulation<Dim>::record_gate() {
+  // Serial: one compare per particle, a few µs per step against milliseconds for the step.
+  auto& P = particles_;
+  const double gx = scene_.gate_x();
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    if (P.gate_eps[p] >= 0.0f || P.x[p][0] < gx) continue;
+    P.gate_eps[p] = static_cast<float>(P.eps_v_p[p]);
+    gate_passed_volume_ += P.vol0[p];
+  }
+}
+
+template <int Dim>
+double Simulation<Dim>::gate_passed_length() const {
+  return records_gate() ? gate_passed_volume_ / gate_cross_section_ : 0.0;
 }
 
 template <int Dim>
@@ -849,6 +890,19 @@ ParticleSnapshot Simulation<Dim>::snapshot() const {
     // Cauchy σ = V0 τ / V: the force of a particle is V0 τ (MLS) and V = V0 J_E J_P.
     s.sigma_zz_pa[p] = P.tau[p](z, z) / (j_e * std::exp(eps));
     s.volume_m3[p] = P.vol0[p] * j_e * std::exp(eps);  // J = J_E J_P, J_P = exp(ε_v^p)
+  }
+  if (records_gate()) {
+    s.gate_x_m = scene_.gate_x();
+    s.gate_passed_length_m = gate_passed_length();
+    auto add = [&](const std::array<float, Dim>& xr, float eps) {
+      s.gate_x_ref.push_back(xr[0]);
+      s.gate_z_ref.push_back(xr[z]);
+      if constexpr (Dim == 3) s.gate_y_ref.push_back(xr[1]);
+      s.gate_eps_v_p.push_back(eps);
+    };
+    for (std::size_t i = 0; i < gate_archive_eps_.size(); ++i) add(gate_archive_x_[i], gate_archive_eps_[i]);
+    for (std::size_t p = 0; p < n; ++p)
+      if (P.gate_eps[p] >= 0.0f) add(P.x_ref[p], P.gate_eps[p]);
   }
   return s;
 }

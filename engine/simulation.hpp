@@ -68,6 +68,11 @@ class Simulation {
 
   ParticleSnapshot snapshot() const;
 
+  // Measurement gate at scene.gate_x() (when scene.records_gate()): the ice length along flow
+  // that has reached it, Σ V0 of the particles recorded / the slab's cross-section [m].
+  bool records_gate() const { return !particles_.gate_eps.empty(); }
+  double gate_passed_length() const;
+
  private:
   struct Stage {
     std::string name;
@@ -102,6 +107,8 @@ class Simulation {
   void project_particles_out_of_bed();
   void clamp_particles(int axis, double lo, double hi);
   void remove_outflow();
+  void init_gate();
+  void record_gate();
   void update_time_step();
 
   double bed_phi(const Vec<Dim>& x, Vec<Dim>* normal) const;
@@ -135,6 +142,11 @@ class Simulation {
   std::int64_t particle_steps_ = 0;
   std::int64_t return_map_evaluations_ = 0;
   double removed_mass_ = 0.0;
+  // Gate records of particles since removed by the outflow: initial position, ε_v^p at the gate.
+  std::vector<std::array<float, Dim>> gate_archive_x_;
+  std::vector<float> gate_archive_eps_;
+  double gate_passed_volume_ = 0.0;   // Σ V0 of every particle recorded at the gate
+  double gate_cross_section_ = 1.0;   // slab V0 per unit length along flow [m^(Dim−1)]
   double front_x_ = 0.0;
   double max_speed_ = 0.0;
   bool settled_ = false;

@@ -31,6 +31,14 @@ struct ParticleSnapshot {
   std::vector<double> sigma_zz_pa;    // vertical Cauchy stress, tension positive [Pa]
   std::vector<double> volume_m3;      // current volume (area in 2D, per unit depth) [m^3]
 
+  // Measurement gate (empty when the scene records none): one record per particle that has
+  // reached x ≥ gate_x_m, including particles since removed by the outflow: its initial
+  // position and its ε_v^p at the moment it reached the gate (docs/measurement.md).
+  double gate_x_m = 0.0;
+  double gate_passed_length_m = 0.0;  // ice length along flow that has passed the gate [m]
+  std::vector<double> gate_x_ref, gate_y_ref, gate_z_ref, gate_eps_v_p;
+  bool has_gate() const { return !gate_eps_v_p.empty(); }
+
   std::size_t size() const { return x.size(); }
   // Fraction of strength lost, 1 − exp(−ζ ε_v^p) (SPEC §5); 0 with softening off.
   double damage(std::size_t i) const;

@@ -92,7 +92,8 @@ int run_command(const RunCommandOptions& opt) {
   };
   std::ofstream(out / "run_summary.json") << summary.dump(2) << "\n";
 
-  // Crevasses at the end of the run (SPEC §5), and the side view with each one marked.
+  // Crevasses at the end of the run (SPEC §5; in the gate frame when the scene records one,
+  // docs/measurement.md), and the side views with each one marked.
   const analysis::CrevasseMeasurement m =
       analysis::measure_crevasses(r.final_snapshot, analysis::MeasureSettings{});
   analysis::write_crevasses_csv(m, out / "crevasses.csv");
@@ -105,7 +106,17 @@ int run_command(const RunCommandOptions& opt) {
     std::snprintf(extra, sizeof extra, "c = %.3g MPa   Pi = %.3g", scene.tensile_strength / 1e6,
                   pi_group);
     view.title_extra = extra;
-    analysis::write_side_view_png(r.final_snapshot, (out / "side_view.png").string(), view, &m);
+    if (m.settings.frame == "gate") {
+      // The crevasses were measured in the gate frame: the final state is drawn unmarked, and
+      // the recorded pattern at the particles' initial positions gets the marks.
+      analysis::write_side_view_png(r.final_snapshot, (out / "side_view.png").string(), view);
+      analysis::SideViewOptions gate_view = view;
+      gate_view.title_extra += "   damage at the top of the step, at initial positions";
+      analysis::write_side_view_png(analysis::gate_frame_snapshot(r.final_snapshot),
+                                    (out / "gate_view.png").string(), gate_view, &m);
+    } else {
+      analysis::write_side_view_png(r.final_snapshot, (out / "side_view.png").string(), view, &m);
+    }
   }
   if (!opt.quiet) {
     std::fprintf(

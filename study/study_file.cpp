@@ -56,6 +56,7 @@ std::optional<Range> named_range(const std::string& name) {
       {"width_ratio", {0.0, 1e3, true, false}},
       {"cells_per_thickness", {4.0, 1e4, false, false}},
       {"front_past_step_ratio", {0.0, 1e3, true, false}},
+      {"gate_length_ratio", {0.0, 1e3, true, false}},
       {"upstream_length_ratio", {0.0, 1e3, true, false}},
       {"downstream_length_ratio", {0.0, 1e3, true, false}},
   };
@@ -75,6 +76,7 @@ const std::map<std::string, std::string>& named_targets() {
       {"width_ratio", "/ice/width"},
       {"cells_per_thickness", "/numerics/dx"},
       {"front_past_step_ratio", "/run/front_past_step"},
+      {"gate_length_ratio", "/run/gate_length"},
       {"upstream_length_ratio", "/ice/upstream_length"},
       {"downstream_length_ratio", "/bed/downstream_length"},
   };
@@ -262,7 +264,7 @@ analysis::MeasureSettings measure_settings_from_json(const json& j) {
   if (!j.is_object()) fail("measurement", "must be an object");
   const ordered_json o = j;
   refuse_unknown(o, "measurement",
-                 {"damage_threshold", "eps_v_p_threshold", "window_min_x_m", "window_max_x_m",
+                 {"frame", "damage_threshold", "eps_v_p_threshold", "window_min_x_m", "window_max_x_m",
                   "window_margin_over_h", "resolution_floor_over_dx", "link_distance_over_spacing",
                   "surface_reach_over_dx", "surface_smoothing_bins",
                   "surface_bridge_half_width_over_h", "fragmented_fraction", "y_band_width_over_dx",
@@ -274,6 +276,12 @@ analysis::MeasureSettings measure_settings_from_json(const json& j) {
     if (o.contains(key) && !o.at(key).is_null())
       out = number_in(o.at(key), std::string("measurement.") + key, r);
   };
+  if (o.contains("frame")) {
+    const auto& f = o.at("frame");
+    if (!f.is_string() || (f != "auto" && f != "gate" && f != "final"))
+      fail("measurement.frame", "value " + f.dump() + " is not \"auto\", \"gate\" or \"final\"");
+    s.frame = f.get<std::string>();
+  }
   num("damage_threshold", s.damage_threshold, {0.0, 1.0, true, true});
   num("eps_v_p_threshold", s.eps_v_p_threshold, {0.0, 10.0, true, false});
   opt("window_min_x_m", s.window_min_x_m, {-1e9, 1e9, false, false});
@@ -306,6 +314,7 @@ analysis::MeasureSettings measure_settings_from_json(const json& j) {
 json measure_settings_to_json(const analysis::MeasureSettings& s) {
   auto opt = [](const std::optional<double>& v) { return v ? json(*v) : json(nullptr); };
   return {
+      {"frame", s.frame},
       {"damage_threshold", s.damage_threshold},
       {"eps_v_p_threshold", s.eps_v_p_threshold},
       {"window_min_x_m", opt(s.window_min_x_m)},
@@ -517,6 +526,7 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
     }
     if (has("front_past_step_ratio"))
       scene["run"]["front_past_step"] = named["front_past_step_ratio"] * h_i;
+    if (has("gate_length_ratio")) scene["run"]["gate_length"] = named["gate_length_ratio"] * h_i;
     if (has("upstream_length_ratio"))
       scene["ice"]["upstream_length"] = named["upstream_length_ratio"] * h_i;
     if (has("downstream_length_ratio"))

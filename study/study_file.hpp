@@ -28,6 +28,7 @@ inline constexpr const char* kStudyParameterNames[] = {
     "width_ratio",             // w = W_i / H_i (3D)
     "cells_per_thickness",     // H_i / dx
     "front_past_step_ratio",   // stop when the front is this many H_i past the step foot
+    "gate_length_ratio",       // stop when this many H_i of ice have passed the top of the step
     "upstream_length_ratio",   // slab length on the plateau / H_i
     "downstream_length_ratio"  // floor length past the step / H_i
 };

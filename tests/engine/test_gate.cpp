@@ -1,0 +1,144 @@
+// The measurement gate at the top of the step (docs/measurement.md, "Gate frame"): each particle
+// is recorded once, when it first reaches x ≥ gate_x, with its initial position and the ε_v^p it
+// carries then; records outlive the outflow; run.gate_length stops the run.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+#include <vector>
+
+#include "engine/error.hpp"
+#include "engine/run.hpp"
+#include "engine/simulation.hpp"
+
+namespace crevasse {
+namespace {
+
+nlohmann::json glacier_json() {
+  std::ifstream f(std::string(CREVASSE_SOURCE_DIR) + "/studies/scenes/glacier_2d.json");
+  return nlohmann::json::parse(f);
+}
+
+// The particles of the slab's front column (within one particle spacing of the gate).
+std::vector<std::size_t> front_column(const Simulation<2>& sim) {
+  const auto& P = sim.particles();
+  const double h = sim.scene().dx / sim.scene().particles_per_cell_axis;
+  std::vector<std::size_t> out;
+  for (std::size_t p = 0; p < P.size(); ++p)
+    if (P.x[p][0] > sim.scene().gate_x() - h) out.push_back(p);
+  return out;
+}
+
+TEST(Gate, RecordsEachParticleOnceWithTheDamageItCarriedAtTheGate) {
+  const SceneConfig scene = scene_from_json(glacier_json());
+  ASSERT_TRUE(scene.records_gate());
+  Simulation<2> sim(scene);
+  sim.settle();
+  ASSERT_TRUE(sim.records_gate());
+  EXPECT_EQ(sim.snapshot().gate_eps_v_p.size(), 0u);  // nothing has reached the gate yet
+  EXPECT_EQ(sim.gate_passed_length(), 0.0);
+
+  // Push the front column 1 m past the gate with a known ε_v^p, remembering where it started.
+  auto& P = sim.mutable_particles();
+  const std::vector<std::size_t> column = front_column(sim);
+  ASSERT_EQ(column.size(), static_cast<std::size_t>(scene.ice_thickness / 5.0));  // 20 particles
+  std::vector<std::array<double, 2>> start;
+  for (std::size_t p : column) {
+    start.push_back({P.x[p][0], P.x[p][1]});
+    P.x[p][0] = scene.gate_x() + 1.0;
+    P.eps_v_p[p] = 0.3;
+  }
+  sim.step();
+  ParticleSnapshot s = sim.snapshot();
+  ASSERT_EQ(s.gate_eps_v_p.size(), column.size());
+  EXPECT_EQ(s.gate_x_m, scene.gate_x());
+  for (std::size_t k = 0; k < column.size(); ++k) {
+    // One step may open the moved particles a little more; 1e-3 is 300× the softening scale
+    // of one step at this strain rate and far below the 0.3 written.
+    EXPECT_NEAR(s.gate_eps_v_p[k], 0.3, 1e-3);
+  }
+  // Initial positions: the seeding lattice (the front column's centres at gate − h/2), not
+  // where settling left them (a few cm away); stored as float, 1e-4 m at x ~ 500 m.
+  const double h = scene.dx / scene.particles_per_cell_axis;
+  for (double x : s.gate_x_ref) EXPECT_NEAR(x, scene.gate_x() - 0.5 * h, 1e-4);
+  for (std::size_t k = 0; k < start.size(); ++k) EXPECT_NEAR(s.gate_x_ref[k], start[k][0], 0.1);
+  // Passed length: one column of particles = one particle spacing of slab (h·H_i / H_i).
+  EXPECT_NEAR(sim.gate_passed_length(), h, 1e-9 * h);
+  EXPECT_NEAR(s.gate_passed_length_m, h, 1e-9 * h);
+
+  // Later damage does not change a record, and a particle is recorded only once. (A step may
+  // reorder the particles, so the recorded ones are found again by their records.)
+  for (std::size_t p = 0; p < P.size(); ++p)
+    if (P.gate_eps[p] >= 0.0f) P.eps_v_p[p] = 0.9;
+  sim.step();
+  s = sim.snapshot();
+  EXPECT_EQ(s.gate_eps_v_p.size(), column.size());
+  for (double e : s.gate_eps_v_p) EXPECT_NEAR(e, 0.3, 1e-3);
+  EXPECT_NEAR(sim.gate_passed_length(), h, 1e-9 * h);
+}
+
+TEST(Gate, RecordsOutliveTheOutflow) {
+  const SceneConfig scene = scene_from_json(glacier_json());
+  Simulation<2> sim(scene);
+  sim.settle();
+  auto& P = sim.mutable_particles();
+  const std::vector<std::size_t> column = front_column(sim);
+  for (std::size_t p : column) {
+    P.x[p][0] = scene.gate_x() + 1.0;
+    P.eps_v_p[p] = 0.3;
+  }
+  sim.step();
+  ASSERT_EQ(sim.snapshot().gate_eps_v_p.size(), column.size());
+  // Now throw the recorded column into the outflow zone at the end of the floor.
+  const double x_end = scene.upstream_length + scene.step_length + scene.downstream_length;
+  const std::size_t n_before = P.size();
+  std::size_t thrown = 0;
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    if (P.gate_eps[p] < 0.0f) continue;  // a step may reorder particles: find them again
+    P.x[p][0] = x_end - scene.dx;
+    ++thrown;
+  }
+  ASSERT_EQ(thrown, column.size());
+  sim.step();
+  EXPECT_EQ(sim.particles().size(), n_before - column.size());  // removed
+  const ParticleSnapshot s = sim.snapshot();
+  ASSERT_EQ(s.gate_eps_v_p.size(), column.size());  // still recorded
+  for (double e : s.gate_eps_v_p) EXPECT_NEAR(e, 0.3, 1e-3);
+}
+
+TEST(Gate, GateLengthStopsTheRun) {
+  nlohmann::json j = glacier_json();
+  j["run"] = {{"gate_length", 30.0}, {"end_time", 200.0}};
+  j["output"]["vtu_interval"] = 0.0;
+  const SceneConfig scene = scene_from_json(j);
+  const RunSummary r = run_scene(scene);
+  EXPECT_EQ(r.stop_reason, "gate_length");
+  // Checked every step; one step passes far less than one particle column (5 m) at 4 m/s, but
+  // a column reaches the gate at once, so the overshoot is at most about one column.
+  EXPECT_GE(r.final_snapshot.gate_passed_length_m, 30.0);
+  EXPECT_LT(r.final_snapshot.gate_passed_length_m, 30.0 + 2.0 * 5.0);
+  EXPECT_LT(r.sim_time_s, 200.0);
+}
+
+TEST(Gate, GateLengthIsRefusedWhereThereIsNoGate) {
+  nlohmann::json j = glacier_json();
+  j["run"]["gate_length"] = 600.0;  // more than the 500 m slab
+  try {
+    scene_from_json(j);
+    FAIL() << "gate_length beyond the slab was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("run.gate_length"), std::string::npos) << e.what();
+  }
+  j = glacier_json();
+  j["run"]["gate_length"] = 100.0;
+  j["effects"] = {"gravity", "drive", "basal_friction", "outflow"};  // elastic: no damage to record
+  try {
+    scene_from_json(j);
+    FAIL() << "gate_length without plasticity was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("run.gate_length"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace crevasse
