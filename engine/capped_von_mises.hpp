@@ -47,21 +47,24 @@ inline double cap_pressure(const CappedVonMisesParams& p, double eps_v_p) {
   return -p.tensile_strength_c * std::exp(-p.softening_zeta * eps_v_p);
 }
 
-// Solves g(Δ) = p_tr + K Δ + c·exp(−ζ(ε_v + Δ)) = 0 for Δ > 0, given g(0) < 0.
-// g is increasing and convex while cζe^{−ζε} < K, so Newton from the right end of the bracket
-// [0, −p_tr/K] (where g > 0) converges monotonically; bisection guards the rare bad step.
-// Outside that range (ζ ≥ K/c: local snap-back, no unique root) the cap is taken explicitly
-// at the start-of-step ε_v^p, which is stable for any step size.
+// Solves g(Δ) = p_tr + K Δ + c·exp(−ζ(ε_v + Δ)) = 0 for Δ > 0, given g(0) < 0 (the trial state
+// is past the cap). g is convex (g'' = cζ² e^{−ζ(ε+Δ)} > 0) and g(0) < 0, so {g ≤ 0} is an
+// interval starting at 0 and the root is unique for every ζ, including cζ ≥ K where the local
+// law snaps back (g is then first decreasing). The bracket [0, −p_tr/K] holds it (g(hi) =
+// c·e^{..} > 0); Newton steps are taken when they stay inside the bracket, bisection otherwise.
+// The returned state lies exactly on the softened cap p = p_c(ε_v + Δ), so the yield condition
+// holds at the end of every step (before engine 0.3.1 the case cζ ≥ K was returned explicitly to
+// the start-of-step cap and ended outside the softened one).
 inline double cap_return_increment(double p_trial, double bulk_k, double eps_v_p,
                                    const CappedVonMisesParams& p) {
   const double c = p.tensile_strength_c;
   const double zeta = p.softening_zeta;
   const double pc_now = cap_pressure(p, eps_v_p);
-  if (zeta <= 0.0 || c * zeta >= bulk_k) return (pc_now - p_trial) / bulk_k;
+  if (zeta <= 0.0) return (pc_now - p_trial) / bulk_k;  // perfectly plastic cap: exact
   double lo = 0.0;
   double hi = -p_trial / bulk_k;  // g(hi) = c·exp(..) > 0 because p_trial < 0
   double d = hi;
-  for (int it = 0; it < 60; ++it) {
+  for (int it = 0; it < 200; ++it) {
     const double e = c * std::exp(-zeta * (eps_v_p + d));
     const double g = p_trial + bulk_k * d + e;
     if (g > 0.0) hi = d; else lo = d;

@@ -145,6 +145,9 @@ class Simulation {
   // Gate records of particles since removed by the outflow: initial position, ε_v^p at the gate.
   std::vector<std::array<float, Dim>> gate_archive_x_;
   std::vector<float> gate_archive_eps_;
+  // Largest physically possible particle speed [m/s] (slab scenes with gravity; 0 = none):
+  // a faster particle means a numerical instability (update_time_step).
+  double speed_bound_ = 0.0;
   double gate_passed_volume_ = 0.0;   // Σ V0 of every particle recorded at the gate
   double gate_cross_section_ = 1.0;   // slab V0 per unit length along flow [m^(Dim−1)]
   double front_x_ = 0.0;

@@ -14,9 +14,9 @@
 // docs/reliability.md ("Hard cases"); scripts/hard_cases.sh runs them all, the disabled ones
 // included, and prints a table.
 //
-// DISABLED_ cases are engine bugs found by this suite and not fixed here (engine/ was being
-// changed by someone else); each comment gives the measured failure. They run with
-// --gtest_also_run_disabled_tests (scripts/hard_cases.sh does).
+// Three engine bugs this suite found were fixed in engine 0.3.1 (Π = 5 yield overshoot, CFL 2
+// accepted but unstable, mild instability undiagnosed); each case's comment keeps the measured
+// failure from before the fix.
 #include <gtest/gtest.h>
 
 #include "engine/error.hpp"
@@ -68,7 +68,8 @@ void expect_diagnosis(const std::string& message) {
   EXPECT_NE(message.find("step "), std::string::npos) << message;
   EXPECT_NE(message.find("particle "), std::string::npos) << message;
   const bool names_quantity = message.find("non-finite velocity or stress") != std::string::npos ||
-                              message.find("in one step") != std::string::npos;
+                              message.find("in one step") != std::string::npos ||
+                              message.find("above the physical bound") != std::string::npos;
   EXPECT_TRUE(names_quantity) << message;
   EXPECT_NE(message.find("numerics.cfl"), std::string::npos) << message;
 }
@@ -91,25 +92,17 @@ TEST(HardCase, CohesionRatio0p005) {
 }
 
 // High cohesion, Π = 5 (c = 4.5 MPa): no fracture expected.
-// DISABLED (engine bug): Φ/c = 1.8e-6 at the end, above the tolerance 1e-6 (5.7e-4 with
+// Before engine 0.3.1 (bug, now fixed): Φ/c = 1.8e-6 at the end, above the tolerance 1e-6 (5.7e-4 with
 // dx = H_i/4). Here c ζ = 4.5e6 Pa × 625 = 2.8e9 Pa exceeds the 2D bulk modulus K = 9.6e8 Pa, so
 // cap_return_increment (engine/capped_von_mises.hpp) takes the "local snap-back" branch: the
 // stress is returned to the cap at the start-of-step ε_v^p while ε_v^p still grows by Δ, so a
 // particle that opens ends outside the softened cap p_c(ε_v^p + Δ) by c (e^{−ζε} − e^{−ζ(ε+Δ)}).
 // Any scene with Π ρ_i g H_i ζ ≥ K (strong ice on a coarse grid: ζ = 50 dx/m by default) is
-// affected. The rest of the checks pass: CohesionRatio5ExceptYield below.
-TEST(HardCase, DISABLED_CohesionRatio5) {
+// affected. Since 0.3.1 the cap return is implicit for every ζ (the root is unique: g is convex).
+TEST(HardCase, CohesionRatio5) {
   SmallGlacier g = base();
   g.cohesion_ratio = 5.0;
   run_and_check(hard_scene(g));
-}
-
-// Π = 5 with every check but the strict yield tolerance, which the engine bug above breaks:
-// Φ/c ≤ 1e-2 only (the overshoot of one explicit cap step).
-TEST(HardCase, CohesionRatio5ExceptYield) {
-  SmallGlacier g = base();
-  g.cohesion_ratio = 5.0;
-  run_and_check(hard_scene(g), 1e-2);
 }
 
 // Thin ice, H_i = 50 m (dx = 6.25 m, the same 768 particles).
@@ -140,19 +133,28 @@ TEST(HardCase, Cfl1) {
   run_and_check(hard_scene(g));
 }
 
-// CFL 2, the documented maximum (numerics.cfl is validated in (0, 2]; README, reliability.md).
-// DISABLED (engine bug): the validation accepts CFL 2 but the explicit update is unstable
+// CFL 2, the largest value validation accepts (numerics.cfl in (0, 2]; ≤ 1 is the documented
+// stable range, README and reliability.md): the run must stay within the bounds or stop with a
+// diagnosis. Before engine 0.3.1 (bug): the validation accepted CFL 2 but the explicit update is unstable
 // there. Measured: SimulationError "step 9, t = 0.166944 s: particle 767 at (313.613, 211.944)
 // m moved 24.216370 m in one step (> dx = 12.500000 m) at speed 1728.271187 m/s", during the
 // settling phase (2.5 s; its steps and time are reset at its end, so the message's "step 9,
 // t = 0.17 s" does not say it was settling). With dx = H_i/4 the limit lies between CFL 1.5
 // (runs, all checks pass) and 1.7 (diagnosed at step 1701); between 1.55 and 1.65 the run is
 // not diagnosed at all, see DISABLED_MildlyUnstableCflIsDiagnosed. The validated maximum
-// should be ≤ 1 (or the engine's checks should catch the instability).
-TEST(HardCase, DISABLED_CflMax2) {
+// should be ≤ 1 (or the engine's checks should catch the instability). Now the settling
+// blow-up is diagnosed as such ("settling (before t = 0), step 9 ...").
+TEST(HardCase, CflMax2IsStableOrDiagnosed) {
   SmallGlacier g = base();
   g.cfl = 2.0;
-  run_and_check(hard_scene(g));
+  const SceneConfig s = hard_scene(g);
+  try {
+    const test::HardResult r = test::run_hard_case(s);
+    test::expect_stable(s, r);
+  } catch (const SimulationError& e) {
+    std::printf("[hard] CflMax2IsStableOrDiagnosed: diagnosed: %s\n", e.what());
+    expect_diagnosis(e.what());
+  }
 }
 
 // 3D at the base groups (W_i = H_i, free-slip side walls), on the coarsest grid, dx = H_i/4:
@@ -178,13 +180,14 @@ TEST(HardCase, PastStabilityStopsWithDiagnosis) {
 
 // Just past the stability limit, CFL 1.6 at dx = H_i/4: the run must either stay within the
 // bounds or stop with a diagnosis.
-// DISABLED (engine bug): it does neither. Measured: the run finishes all 2,429 steps with no
+// Before engine 0.3.1 (bug) it did neither. Measured: the run finishes all 2,429 steps with no
 // error, but particles reach 453 m/s (the physical bound 2 V_x + sqrt(2 g (H_s + H_i)) is
 // 70.6 m/s) from the first step after settling, and KE reaches 462 E_drive (bound 312). At
 // CFL 1.55 and 1.65 the same (135 and 514 m/s). The engine's only checks are a non-finite
 // state and a particle moving more than dx in one step (Simulation::update_time_step), which
-// a mild instability never trips: garbage results are stored as a finished case.
-TEST(HardCase, DISABLED_MildlyUnstableCflIsDiagnosed) {
+// a mild instability never trips: garbage results were stored as a finished case. Since 0.3.1
+// a speed above 1.5 × that bound stops the run with a diagnosis.
+TEST(HardCase, MildlyUnstableCflIsDiagnosed) {
   SmallGlacier g = base();
   g.cells_per_thickness = 4.0;
   g.cfl = 1.6;
