@@ -44,6 +44,8 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
     }
   };
   maybe_output();
+  const double snap_interval = obs ? obs->snapshot_interval_s() : 0.0;
+  double next_snap = snap_interval;
 
   double last_report = 0.0;
   std::int64_t last_steps = 0, last_psteps = 0;
@@ -56,6 +58,10 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
     if (sim.particles().size() == 0) { out.stop_reason = "no_ice_left"; break; }
     sim.step();
     maybe_output();
+    if (snap_interval > 0.0 && sim.time() + 1e-12 >= next_snap) {
+      obs->on_snapshot(sim.snapshot());
+      while (next_snap <= sim.time() + 1e-12) next_snap += snap_interval;
+    }
     const double wall = std::chrono::duration<double>(clock::now() - t0).count();
     if (scene.wall_time_limit > 0 && wall > scene.wall_time_limit) {
       throw SimulationError("time limit: run.wall_time_limit = " + std::to_string(scene.wall_time_limit) +

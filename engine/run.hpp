@@ -28,6 +28,10 @@ class RunObserver {
   virtual void on_progress(const RunProgress&) {}
   // Called at t = 0 and every scene.vtu_interval of simulated time, when that interval is > 0.
   virtual void on_output(const ParticleSnapshot&, int /*index*/) {}
+  // Called every snapshot_interval_s() of simulated time when that is > 0 (e.g. to measure the
+  // crevasses while the run goes on), independently of the VTU output.
+  virtual double snapshot_interval_s() const { return 0.0; }
+  virtual void on_snapshot(const ParticleSnapshot&) {}
   // Return true to stop the run early (cancellation); the run then ends with "cancelled".
   virtual bool cancelled() { return false; }
   // Wall seconds between on_progress calls.

@@ -44,6 +44,7 @@ int main(int argc, char** argv) {
   run->add_option("scene", run_opt.scene_path, "Scene JSON file (see README, studies/scenes/)")->required();
   run->add_option("--out", run_opt.out_dir, "Output directory")->required();
   run->add_option("--vtu-interval", run_opt.vtu_interval, "Simulated seconds between VTU snapshots (overrides the scene)")->check(CLI::Range(0.0, 1e9));
+  run->add_option("--measure-interval", run_opt.measure_interval, "Also measure the crevasses every this many simulated seconds, to see whether the pattern has settled (measurements_over_time.csv)")->check(CLI::Range(0.0, 1e9));
   run->add_option("--threads", run_opt.threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 1024));
   run->add_flag("--quiet", run_opt.quiet, "No progress output");
 

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 
 #include "analysis/crevasse_measure.hpp"
 #include "analysis/measurement_io.hpp"
@@ -43,7 +44,32 @@ class CliObserver : public RunObserver {
   }
   void finish() { printer_.finish(); }
 
+  // Periodic measurements (--measure-interval): one row per snapshot, and the final one.
+  void set_measure_interval(double s) { measure_interval_ = s; }
+  double snapshot_interval_s() const override { return measure_interval_; }
+  void on_snapshot(const ParticleSnapshot& s) override { add_row(s, analysis::measure_crevasses(s)); }
+  void add_row(const ParticleSnapshot& s, const analysis::CrevasseMeasurement& m) {
+    if (measure_interval_ <= 0.0) return;
+    const bool first = !rows_;
+    std::ofstream f(out_ / "measurements_over_time.csv", first ? std::ios::trunc : std::ios::app);
+    if (first)
+      f << "time_s,gate_passed_length_m,frame,window_min_x_m,window_max_x_m,crevasse_count,"
+           "spacing_q25_m,spacing_median_m,spacing_q75_m,depth_median_m,fragmented,no_crevasse\n";
+    auto num = [](const std::optional<analysis::QuartileSummary>& q, int k) {
+      if (!q) return std::string();
+      return std::to_string(k == 0 ? q->q25 : k == 1 ? q->median : q->q75);
+    };
+    f << s.time_s << "," << s.gate_passed_length_m << "," << m.settings.frame << ","
+      << m.settings.window_min_x_m << "," << m.settings.window_max_x_m << ","
+      << m.crevasses.size() << "," << num(m.spacing_m, 0) << "," << num(m.spacing_m, 1) << ","
+      << num(m.spacing_m, 2) << "," << num(m.depth_m, 1) << "," << m.flags.fragmented << ","
+      << m.flags.no_crevasse << "\n";
+    ++rows_;
+  }
+
  private:
+  double measure_interval_ = 0.0;
+  int rows_ = 0;
   fs::path out_;
   bool quiet_;
   ProgressPrinter printer_;
@@ -70,6 +96,7 @@ int run_command(const RunCommandOptions& opt) {
                                                     opt.threads);
 
   CliObserver obs(out, opt.quiet);
+  obs.set_measure_interval(opt.measure_interval);
   RunSummary r = run_scene(scene, &obs);
   obs.finish();
 
@@ -96,6 +123,7 @@ int run_command(const RunCommandOptions& opt) {
   // docs/measurement.md), and the side views with each one marked.
   const analysis::CrevasseMeasurement m =
       analysis::measure_crevasses(r.final_snapshot, analysis::MeasureSettings{});
+  obs.add_row(r.final_snapshot, m);
   analysis::write_crevasses_csv(m, out / "crevasses.csv");
   analysis::write_measurement_summary(m, out / "measurement.json");
   if (scene.png && r.final_snapshot.size() > 0) {

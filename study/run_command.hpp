@@ -8,6 +8,7 @@ struct RunCommandOptions {
   std::string scene_path;
   std::string out_dir;
   double vtu_interval = -1.0;  // overrides output.vtu_interval when ≥ 0
+  double measure_interval = 0.0;  // > 0: measure every this many simulated seconds as well
   int threads = 0;             // 0 = all cores
   bool quiet = false;
 };

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <sstream>
 #include <thread>
+#include <vector>
 
 #include "study_test_support.hpp"
 
@@ -44,6 +45,31 @@ TEST(Cli, InvalidStudyFilesExitWithCode2AndCreateNoDatabase) {
   }
   EXPECT_EQ(run_cli(dir.path(), "study bad.json --shard 3/2").code, 2);
   EXPECT_EQ(run_cli(dir.path(), "status no_such.db").code, 2);
+}
+
+// crevasse run --measure-interval: one row per interval of simulated time plus the final
+// measurement, in time order, with the gate frame for a slab on a step.
+TEST(Cli, RunMeasuresAtIntervalsWhenAsked) {
+  test::ScratchDir dir("cli");
+  nlohmann::json scene = test::tiny_scene();
+  scene["run"] = {{"end_time", 30.0}};
+  test::write_text(dir / "scene.json", scene.dump());
+  const Result r = run_cli(dir.path(), "run scene.json --out out --measure-interval 10 --quiet");
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::istringstream csv(read_file(dir / "out/measurements_over_time.csv"));
+  std::string line;
+  ASSERT_TRUE(std::getline(csv, line));
+  EXPECT_EQ(line.rfind("time_s,gate_passed_length_m,frame,", 0), 0u) << line;
+  std::vector<double> times;
+  while (std::getline(csv, line)) {
+    times.push_back(std::stod(line.substr(0, line.find(','))));
+    EXPECT_NE(line.find(",gate,"), std::string::npos) << line;
+  }
+  // t = 10, 20 and 30 s (each the first step at or past the interval), then the final state,
+  // which is the 30 s state again.
+  ASSERT_EQ(times.size(), 4u);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(times[k], 10.0 * (k + 1), 0.1) << k;
+  EXPECT_GE(times[3], times[2]);
 }
 
 TEST(Cli, StudyStatusExportAndSqlite3) {
