@@ -11,6 +11,7 @@
 #include "engine/error.hpp"
 #include "study/case_hash.hpp"
 #include "study/scene_file.hpp"
+#include "study/scene_file.hpp"
 
 namespace crevasse {
 namespace {
@@ -534,6 +535,7 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
 
     try {
       c.scene = scene_from_json(scene);
+      check_scene_json(scene, c.scene);  // the fields the engine would otherwise ignore
     } catch (const InputError& e) {
       throw InputError(where + ": " + e.what());
     }

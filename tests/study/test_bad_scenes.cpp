@@ -112,18 +112,6 @@ TEST(BadScenes, EveryFileGetsItsOwnMessage) {
   }
 }
 
-// Files refused by check_scene_json (study/scene_file.cpp), which `crevasse run` applies but
-// the study loader does not yet: study/study_file.cpp builds each case with scene_from_json
-// directly, so as base scenes of a study these would run. Remove an entry once the study loader
-// calls check_scene_json too.
-const std::set<std::string> kRefusedByRunOnly = {
-    "bed_z_given_for_step_bed.json",        "box_walls_without_wall_axes.json",
-    "domain_given_for_slab.json",           "domain_min_too_far.json",
-    "flat_bed_z_above_ice.json",            "velocity_boundaries_without_boxes.json",
-    "velocity_box_velocity_too_fast.json",  "velocity_boxes_without_effect.json",
-    "wall_axes_without_box_walls.json",
-};
-
 // Every file of a directory, by name: its bytes (what "unchanged" means for a database, its
 // WAL and shared-memory files, and any journal a writer would leave).
 std::map<std::string, std::string> snapshot(const fs::path& dir) {
@@ -147,7 +135,6 @@ TEST(BadStudies, ExistingDatabaseIsByteForByteUnchanged) {
   // The scene corpus as base scenes of a study with the same name as the stored one ...
   std::vector<std::pair<std::string, std::string>> studies;  // text, field
   for (const auto& [file, field] : expected_fields()) {
-    if (kRefusedByRunOnly.count(file)) continue;
     nlohmann::json s = {{"name", "keep"}, {"base_scene", (kCorpus / file).string()}};
     studies.emplace_back(s.dump(), field);
   }
