@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
 
 #include "engine/error.hpp"
 #include "engine/simulation.hpp"
@@ -17,6 +18,12 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
   RunSummary out;
   out.initial_mass = sim.total_mass();
   out.initial_particles = sim.particles().size();
+  const std::string checkpoint = obs ? obs->checkpoint_path() : std::string();
+  if (!checkpoint.empty() && std::filesystem::exists(checkpoint)) {
+    sim.load_checkpoint(checkpoint);
+    out.resumed_from_time_s = sim.time();
+  }
+  double last_checkpoint_wall = 0.0;
   // The front that counts is that of the connected ice, not of debris thrown ahead of it.
   double ice_front = sim.ice_front_x();
   const double front0 = ice_front;
@@ -69,6 +76,10 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
                             std::to_string(sim.steps()) + " (" +
                             std::to_string(static_cast<int>(100 * fraction())) + "% done)");
     }
+    if (!checkpoint.empty() && wall - last_checkpoint_wall >= obs->checkpoint_interval_s()) {
+      sim.save_checkpoint(checkpoint);
+      last_checkpoint_wall = wall;
+    }
     if (obs && wall - last_report >= obs->progress_interval_s()) {
       RunProgress pr;
       const double span = wall - last_report;
@@ -85,8 +96,16 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
       last_report = wall;
       last_steps = sim.steps();
       last_psteps = sim.particle_steps();
-      if (obs->cancelled()) { out.stop_reason = "cancelled"; break; }
+      if (obs->cancelled()) {
+        if (!checkpoint.empty()) sim.save_checkpoint(checkpoint);
+        out.stop_reason = "cancelled";
+        break;
+      }
     }
+  }
+  if (!checkpoint.empty() && out.stop_reason != "cancelled") {
+    std::error_code ec;
+    std::filesystem::remove(checkpoint, ec);
   }
   out.steps = sim.steps();
   out.particle_steps = sim.particle_steps();

@@ -32,6 +32,11 @@ class RunObserver {
   // crevasses while the run goes on), independently of the VTU output.
   virtual double snapshot_interval_s() const { return 0.0; }
   virtual void on_snapshot(const ParticleSnapshot&) {}
+  // Checkpoints: when checkpoint_path() is not empty, the run continues from that file if it
+  // exists (a run killed earlier), writes it every checkpoint_interval_s() wall seconds and when
+  // cancelled, and deletes it when the run ends with a stop rule (Simulation::save_checkpoint).
+  virtual std::string checkpoint_path() const { return {}; }
+  virtual double checkpoint_interval_s() const { return 600.0; }
   // Return true to stop the run early (cancellation); the run then ends with "cancelled".
   virtual bool cancelled() { return false; }
   // Wall seconds between on_progress calls.
@@ -52,6 +57,7 @@ struct RunSummary {
   std::size_t final_particles = 0;
   nlohmann::json stage_seconds;  // per stage: seconds and calls
   double final_ice_front_x = 0.0;  // front of the connected ice at the end [m]
+  double resumed_from_time_s = -1.0;  // simulated time of the checkpoint it continued from; −1: none
   ParticleSnapshot final_snapshot;
 };
 

@@ -6,12 +6,16 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <cmath>
 #include <numbers>
 #include <random>
 #include <sstream>
 
 #include "engine/bspline.hpp"
+#include "engine/checkpoint.hpp"
 #include "engine/error.hpp"
 
 namespace crevasse {
@@ -929,6 +933,83 @@ ParticleSnapshot Simulation<Dim>::snapshot() const {
       if (P.gate_eps[p] >= 0.0f) add(P.x_ref[p], P.gate_eps[p]);
   }
   return s;
+}
+
+template <int Dim>
+void Simulation<Dim>::save_checkpoint(const std::string& path) const {
+  namespace ck = checkpoint;
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream o(tmp, std::ios::binary | std::ios::trunc);
+    if (!o) throw SimulationError("checkpoint: cannot write " + tmp);
+    ck::write_bytes(o, ck::kMagic, sizeof ck::kMagic);
+    ck::put_string(o, CREVASSE_ENGINE_VERSION);
+    ck::put_string(o, scene_to_json(scene_).dump());
+    ck::put(o, static_cast<std::int32_t>(Dim));
+    ck::put(o, time_); ck::put(o, dt_); ck::put(o, steps_); ck::put(o, particle_steps_);
+    ck::put(o, return_map_evaluations_); ck::put(o, removed_mass_); ck::put(o, front_x_);
+    ck::put(o, max_speed_); ck::put(o, static_cast<std::uint8_t>(settled_));
+    ck::put(o, gate_passed_volume_);
+    const auto& P = particles_;
+    ck::put_vector(o, P.x); ck::put_vector(o, P.v); ck::put_vector(o, P.C); ck::put_vector(o, P.F_e);
+    ck::put_vector(o, P.tau); ck::put_vector(o, P.mass); ck::put_vector(o, P.vol0);
+    ck::put_vector(o, P.eps_v_p); ck::put_vector(o, P.drive_x0); ck::put_vector(o, P.x_ref);
+    ck::put_vector(o, P.gate_eps); ck::put_vector(o, gate_archive_x_); ck::put_vector(o, gate_archive_eps_);
+    ck::write_bytes(o, ck::kMagic, sizeof ck::kMagic);  // end marker: a truncated file is refused
+    o.flush();
+    if (!o) throw SimulationError("checkpoint: writing " + tmp + " failed (disk full?)");
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) throw SimulationError("checkpoint: cannot rename " + tmp + " to " + path + ": " + ec.message());
+}
+
+template <int Dim>
+void Simulation<Dim>::load_checkpoint(const std::string& path) {
+  namespace ck = checkpoint;
+  std::ifstream i(path, std::ios::binary);
+  if (!i) throw SimulationError("checkpoint: cannot read " + path);
+  auto bad = [&](const std::string& why) { return SimulationError("checkpoint " + path + ": " + why); };
+  char magic[sizeof ck::kMagic] = {};
+  ck::read_bytes(i, magic, sizeof magic);
+  if (!i || !std::equal(magic, magic + sizeof magic, ck::kMagic)) throw bad("not a crevasse checkpoint");
+  if (ck::get_string(i, 64) != CREVASSE_ENGINE_VERSION) throw bad("written by another engine version");
+  if (ck::get_string(i, 1u << 24) != scene_to_json(scene_).dump()) throw bad("written for another scene");
+  std::int32_t dim = 0;
+  ck::get(i, dim);
+  if (dim != Dim) throw bad("written for another dimension");
+  double time = 0, dt = 0, removed = 0, front = 0, vmax = 0, gate_volume = 0;
+  std::int64_t steps = 0, psteps = 0, rmaps = 0;
+  std::uint8_t settled = 0;
+  ck::get(i, time); ck::get(i, dt); ck::get(i, steps); ck::get(i, psteps); ck::get(i, rmaps);
+  ck::get(i, removed); ck::get(i, front); ck::get(i, vmax); ck::get(i, settled); ck::get(i, gate_volume);
+  Particles<Dim> P;
+  constexpr std::uint64_t kMax = std::uint64_t{1} << 34;
+  const bool ok = ck::get_vector(i, P.x, kMax) && ck::get_vector(i, P.v, kMax) &&
+                  ck::get_vector(i, P.C, kMax) && ck::get_vector(i, P.F_e, kMax) &&
+                  ck::get_vector(i, P.tau, kMax) && ck::get_vector(i, P.mass, kMax) &&
+                  ck::get_vector(i, P.vol0, kMax) && ck::get_vector(i, P.eps_v_p, kMax) &&
+                  ck::get_vector(i, P.drive_x0, kMax) && ck::get_vector(i, P.x_ref, kMax) &&
+                  ck::get_vector(i, P.gate_eps, kMax);
+  std::vector<std::array<float, Dim>> archive_x;
+  std::vector<float> archive_eps;
+  const bool ok2 = ok && ck::get_vector(i, archive_x, kMax) && ck::get_vector(i, archive_eps, kMax);
+  ck::read_bytes(i, magic, sizeof magic);
+  if (!ok2 || !i || !std::equal(magic, magic + sizeof magic, ck::kMagic)) throw bad("truncated or corrupt");
+  const std::size_t n = P.x.size();
+  auto size_ok = [&](std::size_t got, bool present) { return got == (present ? n : 0); };
+  if (P.v.size() != n || P.C.size() != n || P.F_e.size() != n || P.tau.size() != n ||
+      P.mass.size() != n || P.vol0.size() != n || !size_ok(P.eps_v_p.size(), particles_.has_plastic_state()) ||
+      !size_ok(P.drive_x0.size(), !particles_.drive_x0.empty()) ||
+      !size_ok(P.x_ref.size(), records_gate()) || !size_ok(P.gate_eps.size(), records_gate()) ||
+      archive_x.size() != archive_eps.size())
+    throw bad("array sizes disagree");
+  particles_ = std::move(P);
+  gate_archive_x_ = std::move(archive_x);
+  gate_archive_eps_ = std::move(archive_eps);
+  time_ = time; dt_ = dt; steps_ = steps; particle_steps_ = psteps; return_map_evaluations_ = rmaps;
+  removed_mass_ = removed; front_x_ = front; max_speed_ = vmax; settled_ = settled != 0;
+  settling_ = false; gate_passed_volume_ = gate_volume;
 }
 
 template <int Dim>

@@ -68,6 +68,12 @@ class Simulation {
 
   ParticleSnapshot snapshot() const;
 
+  // Checkpoints (engine/checkpoint.hpp): the whole state the next step reads, written atomically
+  // (temporary file, then rename). load_checkpoint throws SimulationError when the file is not a
+  // checkpoint of this scene and engine version, or is truncated.
+  void save_checkpoint(const std::string& path) const;
+  void load_checkpoint(const std::string& path);
+
   // Measurement gate at scene.gate_x() (when scene.records_gate()): the ice length along flow
   // that has reached it, Σ V0 of the particles recorded / the slab's cross-section [m].
   bool records_gate() const { return !particles_.gate_eps.empty(); }

@@ -17,6 +17,8 @@ class CaseObserver : public RunObserver {
   void on_progress(const RunProgress& p) override { ctx_.report_fraction(p.fraction_done); }
   bool cancelled() override { return ctx_.should_stop(); }
   double progress_interval_s() const override { return 0.5; }
+  std::string checkpoint_path() const override { return ctx_.checkpoint_file().string(); }
+  double checkpoint_interval_s() const override { return ctx_.checkpoint_interval_s(); }
 
  private:
   CaseContext& ctx_;
@@ -60,6 +62,7 @@ CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx) {
       {"removed_mass_kg", r.removed_mass},    {"initial_particles", r.initial_particles},
       {"final_particles", r.final_particles}, {"return_map_evaluations", r.return_map_evaluations}};
   out.run_json = {{"engine_wall_s", r.wall_s},
+                  {"resumed_from_time_s", r.resumed_from_time_s},
                   {"stage_seconds", r.stage_seconds},
                   {"particle_steps_per_s",
                    r.wall_s > 0 ? static_cast<double>(r.particle_steps) / r.wall_s : 0.0}};

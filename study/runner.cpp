@@ -210,6 +210,17 @@ RunnerReport run_study(const Study& study, const RunnerOptions& opt) {
       queue.push(std::move(started));
       if (exact_peak_rss) reset_peak_rss();
       CaseContext ctx(threads, time_limit, study.measurement, stop, fraction[slot]);
+      std::filesystem::path checkpoint;
+      if (study.resources.checkpoint_interval_s > 0) {
+        // Next to the database: DB.checkpoints/CASE.ckpt (kept only while the case is unfinished).
+        const std::filesystem::path dir = opt.db_path.string() + ".checkpoints";
+        std::error_code ec;
+        std::filesystem::create_directories(dir, ec);
+        if (!ec) {
+          checkpoint = dir / (c.case_id + ".ckpt");
+          ctx.set_checkpoint(checkpoint, study.resources.checkpoint_interval_s);
+        }
+      }
       CaseOutcome outcome;
       std::string failure;
       try {
@@ -233,6 +244,10 @@ RunnerReport run_study(const Study& study, const RunnerOptions& opt) {
         }
         failure = "time limit: the case ran longer than the case time limit of " +
                   std::to_string(time_limit) + " s";
+      }
+      if (!checkpoint.empty()) {  // finished or failed for good: nothing to continue from
+        std::error_code ec;
+        std::filesystem::remove(checkpoint, ec);
       }
       CaseResult r;
       r.case_id = c.case_id;

@@ -50,6 +50,13 @@ class CaseContext {
   bool should_stop() const { return stop_.load() || time_limit_exceeded(); }
   void report_fraction(double f) { fraction_.store(f); }
   double elapsed_s() const;
+  // Where the case keeps its checkpoint and how often it writes it (wall s); empty: none.
+  void set_checkpoint(std::filesystem::path file, double interval_s) {
+    checkpoint_file_ = std::move(file);
+    checkpoint_interval_s_ = interval_s;
+  }
+  const std::filesystem::path& checkpoint_file() const { return checkpoint_file_; }
+  double checkpoint_interval_s() const { return checkpoint_interval_s_; }
 
  private:
   int threads_;
@@ -58,6 +65,8 @@ class CaseContext {
   const std::atomic<bool>& stop_;
   std::atomic<double>& fraction_;
   std::chrono::steady_clock::time_point start_;
+  std::filesystem::path checkpoint_file_;
+  double checkpoint_interval_s_ = 0.0;
 };
 
 // Runs one case; throws (SimulationError, InputError, anything) to fail it.

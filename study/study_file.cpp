@@ -432,7 +432,11 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
   if (doc.contains("resources")) {
     const ordered_json& r = doc.at("resources");
     if (!r.is_object()) fail("resources", "must be an object");
-    refuse_unknown(r, "resources", {"jobs", "threads_per_case", "case_time_limit_s"});
+    refuse_unknown(r, "resources",
+                   {"jobs", "threads_per_case", "case_time_limit_s", "checkpoint_interval_s"});
+    if (r.contains("checkpoint_interval_s"))
+      st.resources.checkpoint_interval_s = number_in(
+          r.at("checkpoint_interval_s"), "resources.checkpoint_interval_s", {0.0, 1e8, false, false});
     if (r.contains("jobs")) st.resources.jobs = integer_in(r.at("jobs"), "resources.jobs", 0, 1024);
     if (r.contains("threads_per_case"))
       st.resources.threads_per_case =

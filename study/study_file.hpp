@@ -42,6 +42,9 @@ struct StudyResources {
   int jobs = 0;                  // cases at once; 0 = default (see runner.hpp)
   int threads_per_case = 0;      // engine threads per case; 0 = default
   double case_time_limit_s = 0;  // wall seconds per case; 0 = none
+  // Wall seconds between checkpoints of a running case (DB.checkpoints/CASE.ckpt), so that a
+  // study killed and resumed continues each unfinished case from its last checkpoint; 0 = none.
+  double checkpoint_interval_s = 600;
 };
 
 // The dimensionless groups of one case as it runs (computed from the resolved scene, so they

@@ -121,6 +121,53 @@ std::int64_t done_count(const std::filesystem::path& db) {
   }
 }
 
+// Mid-case checkpoints (issue 7, point 3): one long case, SIGKILLed once its checkpoint exists;
+// the resumed study continues it from the checkpoint (run_json.resumed_from_time_s > 0), deletes
+// the checkpoint, and stores the same result as an uninterrupted run.
+TEST(Cli, KilledCaseResumesFromItsCheckpoint) {
+  test::ScratchDir dir("cli");
+  nlohmann::json study = test::tiny_study(2, 20000, "ckpt");
+  study["sweep"] = {{"cohesion_ratio", {0.3}}};
+  study["resources"] = {{"checkpoint_interval_s", 0.2}};
+  test::write_text(dir / "s.json", study.dump(2));
+  const Result ref = run_cli(dir.path(), "study s.json --db ref.db --jobs 1 --threads-per-case 1 --quiet");
+  ASSERT_EQ(ref.code, 0) << ref.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "ref.db.checkpoints") &&
+               !std::filesystem::is_empty(dir / "ref.db.checkpoints"))
+      << "a finished case leaves no checkpoint";
+
+  const std::vector<std::string> args = {"study", (dir / "s.json").string(), "--db",
+                                         (dir / "k.db").string(), "--jobs", "1",
+                                         "--threads-per-case", "1", "--quiet"};
+  const pid_t pid = test::spawn_crevasse(args, (dir / "killed_err.txt").string());
+  ASSERT_GT(pid, 0);
+  const auto deadline = std::chrono::steady_clock::now() + 60s;
+  bool have_checkpoint = false;
+  while (!have_checkpoint && std::chrono::steady_clock::now() < deadline) {
+    std::error_code ec;
+    for (const auto& e : std::filesystem::directory_iterator(dir / "k.db.checkpoints", ec))
+      have_checkpoint |= e.path().extension() == ".ckpt";
+    std::this_thread::sleep_for(5ms);
+  }
+  std::this_thread::sleep_for(100ms);  // let it run on past the checkpoint
+  ASSERT_EQ(::kill(pid, SIGKILL), 0);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(have_checkpoint);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the case ended before it could be killed; make it longer";
+
+  const Result resumed =
+      run_cli(dir.path(), "study s.json --db k.db --jobs 1 --threads-per-case 1 --quiet");
+  ASSERT_EQ(resumed.code, 0) << resumed.err;
+  EXPECT_EQ(test::pragma_integrity(dir / "k.db"), "ok");
+  const auto resumed_from = test::dump_rows(
+      dir / "k.db", "SELECT json_extract(run_json, '$.resumed_from_time_s') FROM cases");
+  ASSERT_EQ(resumed_from.size(), 1u);
+  EXPECT_GT(std::stod(resumed_from[0]), 0.0) << "the case started again from t = 0";
+  EXPECT_TRUE(std::filesystem::is_empty(dir / "k.db.checkpoints"));
+  EXPECT_EQ(test::result_dump(dir / "k.db"), test::result_dump(dir / "ref.db"));
+}
+
 TEST(Cli, SigkillDuringAStudyThenResumeLosesAndRerunsNothing) {
   test::ScratchDir dir("cli");
   constexpr int kCases = 8;
