@@ -222,11 +222,20 @@ Store::~Store() {
 
 void Store::exec(const std::string& sql) {
   char* err = nullptr;
-  if (sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &err) != SQLITE_OK) {
+  if (const int rc = sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &err); rc != SQLITE_OK) {
     const std::string msg = err ? err : sqlite3_errmsg(db_);
     sqlite3_free(err);
+    // A failed write (full disk, file-size limit, lost write permission) surfaces as FULL or
+    // IOERR; the transaction is rolled back, so the finished cases stay whole and a resume
+    // re-runs only the case that was being stored.
+    const int primary = rc & 0xff;
+    const std::string hint =
+        primary == SQLITE_FULL || primary == SQLITE_IOERR || primary == SQLITE_READONLY
+            ? "; the disk may be full or the file not writable: free space or fix the path, then "
+              "run the same command again to resume (cases already stored are kept)"
+            : "";
     throw std::runtime_error("database " + path_.string() + ": " + msg + " (while running '" +
-                             sql.substr(0, 40) + "')");
+                             sql.substr(0, 40) + "')" + hint);
   }
 }
 

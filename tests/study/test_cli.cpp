@@ -168,6 +168,45 @@ TEST(Cli, KilledCaseResumesFromItsCheckpoint) {
   EXPECT_EQ(test::result_dump(dir / "k.db"), test::result_dump(dir / "ref.db"));
 }
 
+// A write that fails (here: a file-size limit, as a full disk would) ends the study with a
+// clear one-line message and exit code 1; the database stays sound with whole cases only, and
+// the same command resumes it to the uninterrupted result. A database path on a read-only file
+// system is refused before anything runs.
+TEST(Cli, FullDiskFailsCleanlyAndResumes) {
+  test::ScratchDir dir("cli");
+  test::write_text(dir / "s.json", test::tiny_study(12, 200, "full").dump(2));
+  const Result ref = run_cli(dir.path(), "study s.json --db ref.db --jobs 1 --quiet");
+  ASSERT_EQ(ref.code, 0) << ref.err;
+
+  // bash: ignore SIGXFSZ so that writes past `ulimit -f` (KiB) fail with EFBIG instead.
+  const std::string cmd = "cd '" + dir.path().string() +
+                          "' && bash -c \"trap '' XFSZ; ulimit -f 200; exec '" CREVASSE_BINARY
+                          "' study s.json --db k.db --jobs 1 --quiet\" 2> full_err.txt";
+  const int status = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+  const std::string err = read_file(dir / "full_err.txt");
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  EXPECT_NE(err.find("the disk may be full"), std::string::npos) << err;
+  EXPECT_EQ(test::pragma_integrity(dir / "k.db"), "ok");
+  EXPECT_EQ(test::dump_rows(dir / "k.db",
+                            "SELECT count(*) FROM cases c WHERE status = 'done' AND NOT EXISTS "
+                            "(SELECT 1 FROM summaries s WHERE s.case_id = c.case_id)")
+                .at(0),
+            "0");
+  const int done_before =
+      std::stoi(test::dump_rows(dir / "k.db", "SELECT count(*) FROM cases WHERE status = 'done'").at(0));
+  EXPECT_LT(done_before, 12) << "the limit did not stop the study; lower it";
+
+  const Result resumed = run_cli(dir.path(), "study s.json --db k.db --jobs 1 --quiet");
+  ASSERT_EQ(resumed.code, 0) << resumed.err;
+  EXPECT_EQ(test::result_dump(dir / "k.db"), test::result_dump(dir / "ref.db"));
+
+  const Result ro = run_cli(dir.path(), "study s.json --db /proc/crevasse_test.db --quiet");
+  EXPECT_EQ(ro.code, 2) << ro.err;
+  EXPECT_NE(ro.err.find("--db /proc/crevasse_test.db"), std::string::npos) << ro.err;
+}
+
 TEST(Cli, SigkillDuringAStudyThenResumeLosesAndRerunsNothing) {
   test::ScratchDir dir("cli");
   constexpr int kCases = 8;
