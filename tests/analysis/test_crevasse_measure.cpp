@@ -339,7 +339,10 @@ TEST(Measure3D, CentralBandGivesTheSameCrevasses) {
   expect_measurement_finite(m);
 }
 
-TEST(MeasurePerformance, MillionParticlesMeasureQuickly) {
+// Scale: a million particles are measured correctly. No time bound here (speed belongs in
+// benchmarks); the time is recorded as a test property, and an accidental O(N²) would show as a
+// ctest timeout (minutes instead of ~0.3 s).
+TEST(MeasureScale, MillionParticlesAreMeasured) {
   // 12.5 km × 125 m at 1.25 m particle spacing: 10^6 particles.
   SlabSpec spec{.dx_m = 2.5, .thickness_m = 125.0, .x_max_m = 12500.0, .noise_over_spacing = 0.2};
   const auto notches = notch_train(spec, 50.0, {30.0, 60.0});
@@ -350,9 +353,7 @@ TEST(MeasurePerformance, MillionParticlesMeasureQuickly) {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_EQ(m.crevasses.size(), notches.size());
-  // Generous: about 0.3 s in a Release build on one core; the bound only catches an
-  // accidental O(N²) (which would take minutes), not ordinary machine variance.
-  EXPECT_LT(seconds, 5.0);
+  RecordProperty("measure_seconds", std::to_string(seconds));
 }
 
 TEST(MeasureWriters, CsvAndJsonAreParseable) {
