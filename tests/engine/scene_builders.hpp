@@ -3,6 +3,7 @@
 // SceneConfig; callers change fields and call resolve() again only through finish().
 #include <algorithm>
 #include <array>
+#include <fstream>
 #include <initializer_list>
 #include <string>
 #include <vector>
@@ -17,6 +18,15 @@ constexpr double kRho = 917.0;
 constexpr double kYoung = 1.0e9;
 constexpr double kPoisson = 0.3;
 constexpr double kG = 9.81;
+
+// A shipped scene file (studies/scenes/), as JSON to patch before scene_from_json; VTU output
+// off so tests write nothing.
+inline nlohmann::json shipped_scene_json(const std::string& file = "glacier_2d.json") {
+  std::ifstream f(std::string(CREVASSE_SOURCE_DIR) + "/studies/scenes/" + file);
+  nlohmann::json j = nlohmann::json::parse(f);
+  j["output"]["vtu_interval"] = 0.0;
+  return j;
+}
 
 // A box of ice [lo, hi] inside the domain [domain_lo, domain_hi] (only the first dim entries
 // are used), starting unstressed, with the given effects. Run control: a large max_steps, as

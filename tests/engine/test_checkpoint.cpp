@@ -12,18 +12,12 @@
 #include "engine/error.hpp"
 #include "engine/run.hpp"
 #include "engine/simulation.hpp"
+#include "scene_builders.hpp"
 
 namespace crevasse {
 namespace {
 
 namespace fs = std::filesystem;
-
-nlohmann::json glacier_json() {
-  std::ifstream f(std::string(CREVASSE_SOURCE_DIR) + "/studies/scenes/glacier_2d.json");
-  nlohmann::json j = nlohmann::json::parse(f);
-  j["output"]["vtu_interval"] = 0.0;
-  return j;
-}
 
 fs::path scratch(const std::string& name) {
   const fs::path p = fs::temp_directory_path() / ("crevasse_ckpt_" + name + "_" + std::to_string(::getpid()));
@@ -47,7 +41,7 @@ void expect_same_state(const ParticleSnapshot& a, const ParticleSnapshot& b) {
 }
 
 TEST(Checkpoint, RestoredSimulationContinuesBitForBit) {
-  const SceneConfig scene = scene_from_json(glacier_json());
+  const SceneConfig scene = scene_from_json(test::shipped_scene_json());
   const fs::path file = scratch("sim");
   Simulation<2> a(scene);
   // 2,050 steps: past a particle re-sort (every 100 steps) on both sides of the checkpoint, and
@@ -67,13 +61,13 @@ TEST(Checkpoint, RestoredSimulationContinuesBitForBit) {
 }
 
 TEST(Checkpoint, OtherSceneAndTruncatedFilesAreRefused) {
-  const SceneConfig scene = scene_from_json(glacier_json());
+  const SceneConfig scene = scene_from_json(test::shipped_scene_json());
   const fs::path file = scratch("refuse");
   Simulation<2> a(scene);
   a.step();
   a.save_checkpoint(file.string());
 
-  nlohmann::json other = glacier_json();
+  nlohmann::json other = test::shipped_scene_json();
   other["ice"]["tensile_strength"] = 2.0e5;
   Simulation<2> b(scene_from_json(other));
   try {
@@ -111,7 +105,7 @@ class CheckpointingObserver : public RunObserver {
 };
 
 TEST(Checkpoint, CancelledRunResumesToTheUninterruptedResult) {
-  nlohmann::json j = glacier_json();
+  nlohmann::json j = test::shipped_scene_json();
   j["run"]["gate_length"] = 100.0;  // a short run, a few seconds
   const SceneConfig scene = scene_from_json(j);
   const RunSummary whole = run_scene(scene);

@@ -6,17 +6,13 @@
 #include <fstream>
 
 #include "engine/simulation.hpp"
+#include "scene_builders.hpp"
 
 namespace crevasse {
 namespace {
 
-nlohmann::json glacier_json() {
-  std::ifstream f(std::string(CREVASSE_SOURCE_DIR) + "/studies/scenes/glacier_2d.json");
-  return nlohmann::json::parse(f);
-}
-
 TEST(Draped, IceFollowsTheBedWithItsThicknessPastTheStep) {
-  nlohmann::json j = glacier_json();
+  nlohmann::json j = test::shipped_scene_json();
   j["ice"]["draped_length"] = 150.0;  // over the 100 m ramp and 50 m of the floor
   const SceneConfig scene = scene_from_json(j);
   Simulation<2> sim(scene);
@@ -39,7 +35,7 @@ TEST(Draped, IceFollowsTheBedWithItsThicknessPastTheStep) {
 }
 
 TEST(IceFront, DebrisAheadOfTheIceDoesNotMoveTheFront) {
-  nlohmann::json j = glacier_json();
+  nlohmann::json j = test::shipped_scene_json();
   const SceneConfig scene = scene_from_json(j);
   Simulation<2> sim(scene);
   const double front0 = sim.ice_front_x();
@@ -61,7 +57,7 @@ TEST(IceFront, DebrisAheadOfTheIceDoesNotMoveTheFront) {
 // lip exceeds 0.5 MPa of tension (so the test can fail); with, it is at most half that
 // (measured 18–26 s: see the test properties; docs/model.md quotes them).
 double worst_tension_near_lip(bool averaging) {
-  nlohmann::json j = glacier_json();
+  nlohmann::json j = test::shipped_scene_json();
   j["effects"] = {"gravity", "drive", "basal_friction", "outflow"};  // elastic
   j["run"]["gate_length"] = 0.0;  // no damage to record without plasticity
   j["bed"]["step_height"] = 40.0;

@@ -10,14 +10,10 @@
 #include "engine/error.hpp"
 #include "engine/run.hpp"
 #include "engine/simulation.hpp"
+#include "scene_builders.hpp"
 
 namespace crevasse {
 namespace {
-
-nlohmann::json glacier_json() {
-  std::ifstream f(std::string(CREVASSE_SOURCE_DIR) + "/studies/scenes/glacier_2d.json");
-  return nlohmann::json::parse(f);
-}
 
 // The particles of the slab's front column (within one particle spacing of the gate).
 std::vector<std::size_t> front_column(const Simulation<2>& sim) {
@@ -30,7 +26,7 @@ std::vector<std::size_t> front_column(const Simulation<2>& sim) {
 }
 
 TEST(Gate, RecordsEachParticleOnceWithTheDamageItCarriedAtTheGate) {
-  const SceneConfig scene = scene_from_json(glacier_json());
+  const SceneConfig scene = scene_from_json(test::shipped_scene_json());
   ASSERT_TRUE(scene.records_gate());
   Simulation<2> sim(scene);
   sim.settle();
@@ -78,7 +74,7 @@ TEST(Gate, RecordsEachParticleOnceWithTheDamageItCarriedAtTheGate) {
 }
 
 TEST(Gate, RecordsOutliveTheOutflow) {
-  const SceneConfig scene = scene_from_json(glacier_json());
+  const SceneConfig scene = scene_from_json(test::shipped_scene_json());
   Simulation<2> sim(scene);
   sim.settle();
   auto& P = sim.mutable_particles();
@@ -107,7 +103,7 @@ TEST(Gate, RecordsOutliveTheOutflow) {
 }
 
 TEST(Gate, GateLengthStopsTheRun) {
-  nlohmann::json j = glacier_json();
+  nlohmann::json j = test::shipped_scene_json();
   j["run"] = {{"gate_length", 30.0}, {"end_time", 200.0}};
   j["output"]["vtu_interval"] = 0.0;
   const SceneConfig scene = scene_from_json(j);
@@ -121,7 +117,7 @@ TEST(Gate, GateLengthStopsTheRun) {
 }
 
 TEST(Gate, GateLengthIsRefusedWhereThereIsNoGate) {
-  nlohmann::json j = glacier_json();
+  nlohmann::json j = test::shipped_scene_json();
   j["run"]["gate_length"] = 600.0;  // more than the 500 m slab
   try {
     scene_from_json(j);
@@ -129,7 +125,7 @@ TEST(Gate, GateLengthIsRefusedWhereThereIsNoGate) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("run.gate_length"), std::string::npos) << e.what();
   }
-  j = glacier_json();
+  j = test::shipped_scene_json();
   j["run"]["gate_length"] = 100.0;
   j["effects"] = {"gravity", "drive", "basal_friction", "outflow"};  // elastic: no damage to record
   try {

@@ -22,6 +22,13 @@ TEST(HardCaseLong, TenTimesTheUsualSimulatedTime) {
   s.end_time = 10.0 * usual;
   const test::HardResult r = test::run_hard_case(s);
   test::expect_stable(s, r);
+  // The run really is ten times as long: it reached 10 T_u with ice left, and dt can never
+  // exceed cfl·dx/c_p, so covering 10 T_u takes at least that many steps (a run that ended
+  // early, or skipped time with oversized steps, fails here).
+  ASSERT_GT(r.final_particles, 0u) << "no ice left to check";
+  EXPECT_GE(r.sim_time, 10.0 * usual * (1 - 1e-12));
+  const double dt_max = s.cfl * s.dx / s.p_wave_speed();
+  EXPECT_GE(static_cast<double>(r.steps), 10.0 * usual / dt_max * (1 - 1e-9));
 }
 
 }  // namespace
