@@ -9,6 +9,7 @@
 #include "analysis/calibration.hpp"
 #include "engine/error.hpp"
 #include "study/case_results.hpp"
+#include "study/field_observations.hpp"
 #include "study/fits_table.hpp"
 #include "study/store.hpp"
 #include "study/study_fit.hpp"
@@ -158,11 +159,129 @@ double positive(double v, const std::string& option) {
   return v;
 }
 
+// Each regime's answer to one observation, or why it refused.
+struct Answer {
+  std::optional<analysis::CohesionEstimate> estimate;
+  std::string refusal;
+};
+
+std::vector<Answer> invert_in_every_regime(const StudyLaws& laws,
+                                           const analysis::SpacingObservation& obs,
+                                           const analysis::CalibrationOptions& options,
+                                           const std::string& bad_input_prefix) {
+  std::vector<Answer> answers;
+  for (const QuantityRegime& r : laws.spacing.regimes) {
+    const analysis::RegimeLaw regime = spacing_regime(r);
+    Answer a;
+    try {
+      a.estimate = analysis::invert_spacing_for_cohesion(regime, obs, options);
+    } catch (const std::out_of_range& e) {
+      a.refusal = e.what();
+    } catch (const std::domain_error& e) {
+      a.refusal = e.what();
+    } catch (const std::invalid_argument& e) {
+      throw InputError(bad_input_prefix + e.what());
+    }
+    answers.push_back(std::move(a));
+  }
+  return answers;
+}
+
+// `crevasse calibrate --observations FILE`: every site of the file against the study's laws,
+// one row per site and regime that answers (or one row saying why none does).
+int calibrate_observations(const CalibrateCommandOptions& opt) {
+  const std::vector<FieldObservation> sites = load_field_observations(opt.observations_path);
+  const StudyLaws laws = load_laws(opt.db_path);
+  analysis::CalibrationOptions options;
+  options.ice = laws.ice;
+  options.level = opt.level;
+  print_header(laws, opt.level);
+  std::printf("observations: %s (%zu sites)\n\n", opt.observations_path.c_str(), sites.size());
+  std::printf("%-32s %9s %-20s %8s %7s  %-26s %10s %-22s %-24s %s\n", "site", "L_p[m]", "spread used",
+              "H_i[m]", "L_p/H_i", "regime", "c[kPa]", "interval[kPa]", "Pi [interval]", "in regime / why not");
+  std::FILE* csv = nullptr;
+  if (!opt.csv_path.empty()) {
+    csv = std::fopen(opt.csv_path.c_str(), "w");
+    if (!csv) throw InputError("--csv: cannot write " + opt.csv_path);
+    std::fprintf(csv,
+                 "id,site,spacing_m,spacing_statistic,spread_used,spread_q25_m,spread_q75_m,thickness_m,"
+                 "regime,c_kpa,c_lo_kpa,c_hi_kpa,pi,pi_lo,pi_hi,pi_in_regime,refusal,reference\n");
+  }
+  const auto quoted = [](const std::string& t) {
+    std::string q = "\"";
+    for (char ch : t) q += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+    return q + "\"";
+  };
+  const auto opt_num = [](const std::optional<double>& v) { return v ? short_number(*v) : std::string(); };
+  for (const FieldObservation& site : sites) {
+    std::string spread;
+    const analysis::SpacingObservation obs = to_spacing_observation(site, &spread);
+    const std::vector<Answer> answers =
+        invert_in_every_regime(laws, obs, options, opt.observations_path + ": " + site.id + ": ");
+    const std::string h = site.thickness_m ? short_number(*site.thickness_m) : "-";
+    const std::string ratio = site.thickness_m ? short_number(site.spacing_m / *site.thickness_m) : "-";
+    const bool any = std::any_of(answers.begin(), answers.end(), [](const Answer& a) { return a.estimate.has_value(); });
+    std::string refusals;
+    for (const Answer& a : answers)
+      if (!a.estimate) refusals += (refusals.empty() ? "" : "; ") + a.refusal;
+    for (std::size_t k = 0; k < answers.size(); ++k) {
+      if (any && !answers[k].estimate) continue;
+      if (!any && k > 0) break;
+      const std::string regime = any ? laws.spacing.regimes[k].name : "-";
+      std::string c = "-", interval = "-", pi = "-", verdict = refusals;
+      if (any) {
+        const analysis::CohesionEstimate& e = *answers[k].estimate;
+        c = short_number(e.tensile_strength_pa / 1e3);
+        interval = range(e.interval_pa.lower / 1e3, e.interval_pa.upper / 1e3);
+        if (e.cohesion_ratio_pi) {
+          pi = short_number(e.cohesion_ratio_pi->value) + " " +
+               range(e.cohesion_ratio_pi->interval.lower, e.cohesion_ratio_pi->interval.upper);
+          verdict = e.pi_in_regime_range.value_or(false)
+                        ? (e.pi_interval_in_regime_range.value_or(false) ? "inside" : "inside (interval reaches out)")
+                        : "OUTSIDE: not self-consistent";
+        } else {
+          verdict = "H_i unknown: regime not checked";
+        }
+      }
+      std::printf("%-32s %9s %-20s %8s %7s  %-26s %10s %-22s %-24s %s\n", site.id.c_str(),
+                  short_number(site.spacing_m).c_str(), spread.c_str(), h.c_str(), ratio.c_str(),
+                  regime.c_str(), c.c_str(), interval.c_str(), pi.c_str(), verdict.c_str());
+      if (csv) {
+        const analysis::CohesionEstimate* e = any ? &*answers[k].estimate : nullptr;
+        std::fprintf(
+            csv, "%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s\n", quoted(site.id).c_str(),
+            quoted(site.site).c_str(), short_number(site.spacing_m).c_str(), site.statistic.c_str(),
+            quoted(spread).c_str(), opt_num(obs.spacing_q25_m).c_str(), opt_num(obs.spacing_q75_m).c_str(),
+            opt_num(site.thickness_m).c_str(), quoted(any ? regime : "").c_str(),
+            e ? short_number(e->tensile_strength_pa / 1e3).c_str() : "",
+            e ? short_number(e->interval_pa.lower / 1e3).c_str() : "",
+            e ? short_number(e->interval_pa.upper / 1e3).c_str() : "",
+            e && e->cohesion_ratio_pi ? short_number(e->cohesion_ratio_pi->value).c_str() : "",
+            e && e->cohesion_ratio_pi ? short_number(e->cohesion_ratio_pi->interval.lower).c_str() : "",
+            e && e->cohesion_ratio_pi ? short_number(e->cohesion_ratio_pi->interval.upper).c_str() : "",
+            e && e->pi_in_regime_range ? (*e->pi_in_regime_range ? "yes" : "no") : "",
+            quoted(any ? "" : refusals).c_str(), quoted(site.reference).c_str());
+      }
+    }
+  }
+  if (csv) std::fclose(csv);
+  std::printf("\nc from the inverted law with its %.0f %% interval (fit uncertainty and the site's spread); "
+              "Pi = c/(rho_i g H_i); a site is in a regime when its Pi lies in the regime's Pi range\n",
+              100.0 * opt.level);
+  return 0;
+}
+
 }  // namespace
 
 int calibrate_command(const CalibrateCommandOptions& opt) {
   if (!(opt.level > 0.5 && opt.level < 1.0))
     throw InputError("--level: " + short_number(opt.level) + " is outside (0.5, 1)");
+  if (!opt.observations_path.empty()) {
+    if (opt.spacing_m != 0.0 || !opt.spacing_quartiles.empty() || opt.thickness_m)
+      throw InputError("--observations: give either --observations or --spacing [--spacing-quartiles] [--thickness], not both");
+    return calibrate_observations(opt);
+  }
+  if (!opt.csv_path.empty()) throw InputError("--csv: only with --observations");
   analysis::SpacingObservation obs;
   obs.spacing_m = positive(opt.spacing_m, "--spacing");
   if (opt.thickness_m) obs.thickness_m = positive(*opt.thickness_m, "--thickness");
@@ -195,26 +314,7 @@ int calibrate_command(const CalibrateCommandOptions& opt) {
   options.ice = laws.ice;
   options.level = opt.level;
 
-  // Each regime's answer, or why it refused.
-  struct Answer {
-    std::optional<analysis::CohesionEstimate> estimate;
-    std::string refusal;
-  };
-  std::vector<Answer> answers;
-  for (const QuantityRegime& r : laws.spacing.regimes) {
-    const analysis::RegimeLaw regime = spacing_regime(r);
-    Answer a;
-    try {
-      a.estimate = analysis::invert_spacing_for_cohesion(regime, obs, options);
-    } catch (const std::out_of_range& e) {
-      a.refusal = e.what();
-    } catch (const std::domain_error& e) {
-      a.refusal = e.what();
-    } catch (const std::invalid_argument& e) {
-      throw InputError(std::string("--spacing: ") + e.what());
-    }
-    answers.push_back(std::move(a));
-  }
+  const std::vector<Answer> answers = invert_in_every_regime(laws, obs, options, "--spacing: ");
   if (std::none_of(answers.begin(), answers.end(), [](const Answer& a) { return a.estimate; })) {
     std::string all;
     for (const Answer& a : answers) all += (all.empty() ? "" : "; ") + a.refusal;

@@ -16,6 +16,8 @@ struct CalibrateCommandOptions {
   std::string spacing_quartiles;  // "q25,q75" [m], or empty
   std::optional<double> thickness_m;
   double level = 0.95;
+  std::string observations_path;  // --observations FILE: every site of the file, as a table
+  std::string csv_path;           // --csv PATH: the table also as CSV (with --observations)
 };
 
 struct PredictCommandOptions {

@@ -103,10 +103,12 @@ int main(int argc, char** argv) {
   std::optional<double> calibrate_thickness;
   auto* calibrate = app.add_subcommand("calibrate", "Estimate the tensile strength c from an observed crevasse spacing");
   calibrate->add_option("--db", calibrate_opt.db_path, "Study database (its fits table, or fits made now)")->required();
-  calibrate->add_option("--spacing", calibrate_opt.spacing_m, "Observed median crevasse spacing L_p [m]")->required();
+  calibrate->add_option("--spacing", calibrate_opt.spacing_m, "Observed median crevasse spacing L_p [m]");
   calibrate->add_option("--spacing-quartiles", calibrate_opt.spacing_quartiles, "Observed spacing quartiles Q25,Q75 [m]");
   calibrate->add_option("--thickness", calibrate_thickness, "Ice thickness H_i at the site [m]");
   calibrate->add_option("--level", calibrate_opt.level, "Confidence level (default 0.95)");
+  calibrate->add_option("--observations", calibrate_opt.observations_path, "Field observations file (studies/field/observations.json): every site as a table, instead of --spacing");
+  calibrate->add_option("--csv", calibrate_opt.csv_path, "With --observations: write the table as CSV too");
 
   crevasse::PredictCommandOptions predict_opt;
   auto* predict = app.add_subcommand("predict", "Predict crevasse spacing and depth for a tensile strength and thickness");
@@ -134,6 +136,8 @@ int main(int argc, char** argv) {
     if (*plot) return crevasse::plot_command(plot_opt);
     if (*calibrate) {
       calibrate_opt.thickness_m = calibrate_thickness;
+      if (calibrate_opt.observations_path.empty() && calibrate->count("--spacing") == 0)
+        throw crevasse::InputError("--spacing: required (the observed median spacing in m), or give --observations FILE");
       return crevasse::calibrate_command(calibrate_opt);
     }
     if (*predict) return crevasse::predict_command(predict_opt);

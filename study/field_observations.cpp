@@ -1,0 +1,120 @@
+#include "study/field_observations.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "engine/error.hpp"
+#include "study/study_fit.hpp"
+
+namespace crevasse {
+namespace {
+
+using nlohmann::json;
+
+std::string where(const std::string& path, std::size_t k, const std::string& field) {
+  return path + ": observations[" + std::to_string(k) + "]." + field;
+}
+
+double positive_number(const json& e, const std::string& key, const std::string& at) {
+  if (!e.contains(key) || !e[key].is_number())
+    throw InputError(at + ": needs a number in (0, 1e6]");
+  const double v = e[key].get<double>();
+  if (!std::isfinite(v) || v <= 0.0 || v > 1e6)
+    throw InputError(at + ": value " + short_number(v) + " is outside the allowed range (0, 1e6]");
+  return v;
+}
+
+std::string text(const json& e, const std::string& key, const std::string& at, bool required) {
+  if (!e.contains(key)) {
+    if (required) throw InputError(at + ": missing (a non-empty string is required)");
+    return "";
+  }
+  if (!e[key].is_string() || (required && e[key].get<std::string>().empty()))
+    throw InputError(at + ": must be a non-empty string");
+  return e[key].get<std::string>();
+}
+
+std::optional<std::pair<double, double>> pair_around(const json& e, const std::string& key,
+                                                     const std::string& at, double spacing) {
+  if (!e.contains(key)) return std::nullopt;
+  const json& v = e[key];
+  if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number())
+    throw InputError(at + ": must be [low, high] in metres");
+  const double lo = v[0].get<double>(), hi = v[1].get<double>();
+  if (!(lo > 0.0 && lo <= spacing && spacing <= hi && hi <= 1e6))
+    throw InputError(at + ": need 0 < low <= spacing_median_m <= high, got [" + short_number(lo) +
+                     ", " + short_number(hi) + "] around " + short_number(spacing));
+  return std::make_pair(lo, hi);
+}
+
+}  // namespace
+
+std::vector<FieldObservation> load_field_observations(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open the observations file");
+  json doc;
+  try {
+    doc = json::parse(in);
+  } catch (const json::parse_error& e) {
+    throw InputError(path + ": not valid JSON: " + e.what());
+  }
+  if (!doc.is_object() || !doc.contains("observations") || !doc["observations"].is_array() ||
+      doc["observations"].empty())
+    throw InputError(path + ": observations: needs a non-empty array of sites");
+  std::vector<FieldObservation> out;
+  std::set<std::string> ids;
+  const json& list = doc["observations"];
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    const json& e = list[k];
+    if (!e.is_object()) throw InputError(where(path, k, "") + " must be an object");
+    FieldObservation o;
+    o.id = text(e, "id", where(path, k, "id"), true);
+    if (!ids.insert(o.id).second) throw InputError(where(path, k, "id") + ": '" + o.id + "' is repeated");
+    o.site = text(e, "site", where(path, k, "site"), true);
+    o.setting = text(e, "setting", where(path, k, "setting"), false);
+    o.reference = text(e, "reference", where(path, k, "reference"), true);
+    o.spacing_m = positive_number(e, "spacing_median_m", where(path, k, "spacing_median_m"));
+    o.statistic = text(e, "spacing_statistic", where(path, k, "spacing_statistic"), true);
+    if (o.statistic != "median" && o.statistic != "mean" && o.statistic != "typical" &&
+        o.statistic != "mode")
+      throw InputError(where(path, k, "spacing_statistic") + ": '" + o.statistic +
+                       "' is not one of median, mean, typical, mode");
+    o.quartiles_m = pair_around(e, "spacing_quartiles_m", where(path, k, "spacing_quartiles_m"), o.spacing_m);
+    o.range_m = pair_around(e, "spacing_range_m", where(path, k, "spacing_range_m"), o.spacing_m);
+    if (e.contains("spacing_sd_m")) o.sd_m = positive_number(e, "spacing_sd_m", where(path, k, "spacing_sd_m"));
+    if (!e.contains("thickness_m"))
+      throw InputError(where(path, k, "thickness_m") + ": missing (a number in (0, 1e6], or null when unknown)");
+    if (!e["thickness_m"].is_null())
+      o.thickness_m = positive_number(e, "thickness_m", where(path, k, "thickness_m"));
+    out.push_back(std::move(o));
+  }
+  return out;
+}
+
+analysis::SpacingObservation to_spacing_observation(const FieldObservation& o, std::string* spread) {
+  analysis::SpacingObservation s;
+  s.spacing_m = o.spacing_m;
+  s.thickness_m = o.thickness_m;
+  std::string used = "none given";
+  if (o.quartiles_m) {
+    s.spacing_q25_m = o.quartiles_m->first;
+    s.spacing_q75_m = o.quartiles_m->second;
+    used = "quartiles";
+  } else if (o.sd_m) {
+    const double half = std::max(0.674 * *o.sd_m, 0.05 * o.spacing_m);
+    s.spacing_q25_m = std::max(o.spacing_m - half, 0.05 * o.spacing_m);
+    s.spacing_q75_m = o.spacing_m + half;
+    used = "±0.674 sd";
+  } else if (o.range_m) {
+    s.spacing_q25_m = o.range_m->first;
+    s.spacing_q75_m = o.range_m->second;
+    used = "range as quartiles";
+  }
+  if (spread) *spread = used;
+  return s;
+}
+
+}  // namespace crevasse

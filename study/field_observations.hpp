@@ -1,0 +1,40 @@
+#pragma once
+// Field observations of crevasse spacing (studies/field/observations.json,
+// docs/field_observations.md), read for `crevasse calibrate --observations`. Each entry is one
+// site: the published spacing (median, mean or typical value), whatever spread the source gives
+// (quartiles, range or standard deviation), the ice thickness when known, and the reference.
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "analysis/calibration.hpp"
+
+namespace crevasse {
+
+struct FieldObservation {
+  std::string id;
+  std::string site;
+  std::string setting;
+  double spacing_m = 0.0;
+  std::string statistic;  // median | mean | typical | mode
+  std::optional<std::pair<double, double>> quartiles_m;
+  std::optional<std::pair<double, double>> range_m;
+  std::optional<double> sd_m;
+  std::optional<double> thickness_m;
+  std::string reference;
+};
+
+// Reads and checks the file. Throws InputError naming the entry and field (one line) for a
+// missing or malformed value, a non-positive spacing or thickness, a spread that does not hold
+// the spacing, or a repeated id.
+std::vector<FieldObservation> load_field_observations(const std::string& path);
+
+// The observation as the calibration takes it. The spread becomes quartiles: given quartiles
+// as they are; else a standard deviation as spacing ± 0.674·sd (the quartiles of a normal
+// distribution), floored at 5 % of the spacing; else a published min–max range used as if it
+// were the quartiles (wider than the true quartiles, so the interval errs wide); else none.
+// `spread` says which was used.
+analysis::SpacingObservation to_spacing_observation(const FieldObservation& o, std::string* spread);
+
+}  // namespace crevasse
