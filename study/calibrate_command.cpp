@@ -224,6 +224,18 @@ int calibrate_observations(const CalibrateCommandOptions& opt) {
     std::string refusals;
     for (const Answer& a : answers)
       if (!a.estimate) refusals += (refusals.empty() ? "" : "; ") + a.refusal;
+    std::string h_hint;
+    if (!site.thickness_m) {
+      // Which thickness would put the site inside what the study covered.
+      double y_lo = INFINITY, y_hi = 0.0;
+      for (const QuantityRegime& r : laws.spacing.regimes) {
+        y_lo = std::min(y_lo, r.y_min);
+        y_hi = std::max(y_hi, r.y_max);
+      }
+      h_hint = "the study's L_p/H_i range " + range(y_lo, y_hi) + " needs H_i in " +
+               range(site.spacing_m / y_hi, site.spacing_m / y_lo) + " m";
+      refusals = "H_i unknown: " + h_hint + "; " + refusals;
+    }
     for (std::size_t k = 0; k < answers.size(); ++k) {
       if (any && !answers[k].estimate) continue;
       if (!any && k > 0) break;
@@ -240,7 +252,7 @@ int calibrate_observations(const CalibrateCommandOptions& opt) {
                         ? (e.pi_interval_in_regime_range.value_or(false) ? "inside" : "inside (interval reaches out)")
                         : "OUTSIDE: not self-consistent";
         } else {
-          verdict = "H_i unknown: regime not checked";
+          verdict = "H_i unknown, regime not checked: " + h_hint;
         }
       }
       std::printf("%-32s %9s %-20s %8s %7s  %-26s %10s %-22s %-24s %s\n", site.id.c_str(),

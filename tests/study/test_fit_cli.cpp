@@ -344,7 +344,10 @@ TEST(FitCli, CalibrateObservationsFile) {
          {"spacing_statistic", "median"}, {"spacing_sd_m", 0.1 * spacing}, {"thickness_m", h},
          {"reference", "synthetic"}},
         {{"id", "too_wide"}, {"site", "B"}, {"spacing_median_m", 100.0 * h},
-         {"spacing_statistic", "mean"}, {"thickness_m", h}, {"reference", "synthetic"}}}}};
+         {"spacing_statistic", "mean"}, {"thickness_m", h}, {"reference", "synthetic"}},
+        {{"id", "no_thickness"}, {"site", "C"}, {"spacing_median_m", spacing},
+         {"spacing_statistic", "typical"}, {"spacing_range_m", {0.5 * spacing, 2.0 * spacing}},
+         {"thickness_m", nullptr}, {"reference", "synthetic"}}}}};
   std::ofstream(dir / "obs.json") << file.dump(2);
   const test::CliResult r =
       test::run_cli(dir.path(), "calibrate --db s.db --observations obs.json --csv obs.csv");
@@ -358,8 +361,12 @@ TEST(FitCli, CalibrateObservationsFile) {
   EXPECT_NE(inside.find("±0.674 sd"), std::string::npos) << inside;
   EXPECT_NE(inside.find(" inside"), std::string::npos) << inside;
   EXPECT_NE(line_of("too_wide").find("outside"), std::string::npos) << r.out;
+  // No thickness and b = 0.5 (not 1): refused, with the thicknesses that would fit the study.
+  const std::string no_h = line_of("no_thickness");
+  EXPECT_NE(no_h.find("range as quartiles"), std::string::npos) << no_h;
+  EXPECT_NE(no_h.find("needs H_i in ["), std::string::npos) << no_h;
   const std::string csv = test::read_file(dir / "obs.csv");
-  ASSERT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3) << csv;  // header + 2 sites
+  ASSERT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4) << csv;  // header + 3 sites
   // The inside site's c: its interval holds the truth, and the estimate is within 10 % of it
   // (the fitted law's error at Π = 0.3 from 5 % log-normal scatter on 20 cases is ~2 %, which
   // b = 0.5 doubles in c).

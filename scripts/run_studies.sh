@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# Regenerates the regime studies in results/ (issue 8; results/README.md says what each file is):
+# runs each study into results/<name>.db (resumable: run it again after an interruption and
+# finished cases are skipped), fits its laws into the database's fits table, draws its figures
+# into results/<name>_figures/ and, for the main study, runs the field calibration.
+#
+#   bash scripts/run_studies.sh                 # every study, in the order below
+#   bash scripts/run_studies.sh slope three_d   # only these
+#
+# Measured cost on the 2-core development VM (one case per core): spacing_vs_cohesion about
+# 45 min of case wall time (45 cases), slope 12 min, step_length 16 min, three_d about 45 min
+# (3 cases of about 15 min), accuracy_cost about 50 min (one case at a time, so that each
+# case's wall time and peak memory are its own).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+crevasse=./build/study/crevasse
+if [[ ! -x $crevasse ]]; then
+  bash scripts/install_deps.sh
+  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
+  cmake --build build -j "$(nproc)"
+fi
+
+studies=("$@")
+if [[ ${#studies[@]} -eq 0 ]]; then
+  studies=(spacing_vs_cohesion slope step_length three_d accuracy_cost)
+fi
+
+for name in "${studies[@]}"; do
+  db=results/$name.db
+  $crevasse study "studies/$name.json" --db "$db"
+  $crevasse status "$db"
+  case $name in
+    spacing_vs_cohesion)
+      # Fragmented cases (the slab shatters into cells' worth of rubble) have no spacing and
+      # their "depth" is that of rubble: left out of the laws, still marked on the figures.
+      $crevasse fit "$db" --group cohesion_ratio thickness --exclude-fragmented
+      $crevasse plot "$db" --out "results/${name}_figures" --colour-by thickness
+      $crevasse calibrate --db "$db" --observations studies/field/observations.json \
+        --csv "results/${name}_figures/field_calibration.csv" \
+        | tee "results/${name}_figures/field_calibration.txt"
+      ;;
+    slope)
+      $crevasse fit "$db" --group slope --exclude-fragmented
+      $crevasse plot "$db" --out "results/${name}_figures" --group slope --colour-by cohesion_ratio
+      ;;
+    step_length)
+      $crevasse fit "$db" --group step_length_ratio --exclude-fragmented
+      $crevasse plot "$db" --out "results/${name}_figures" --group step_length_ratio \
+        --colour-by cohesion_ratio
+      ;;
+    three_d | accuracy_cost)
+      ;;
+  esac
+done
