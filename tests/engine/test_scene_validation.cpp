@@ -114,10 +114,9 @@ TEST(SceneValidation, OutOfRangeValuesAreRefused) {
   }
 }
 
-// DISABLED (engine bug, reported): a negative thickness is refused, but the message names
-// ice.settle_time ("value -0.1238 is outside the allowed range [0, 1e+06]"), because resolve()
-// derives the default settle_time = 30·H_i/c_p from the thickness before it checks the
-// thickness. The user is told to fix a field they never wrote.
+// A negative thickness is refused with a message naming ice.thickness. (Before the fix,
+// resolve() derived the default settle_time = 30·H_i/c_p from the thickness before it checked
+// the thickness, and the message named ice.settle_time, a field the user never wrote.)
 TEST(SceneValidation, NegativeThicknessIsNamed) {
   json j = valid_scene();
   j["ice"]["thickness"] = -5.0;
