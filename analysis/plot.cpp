@@ -172,6 +172,15 @@ std::vector<Tick> log_ticks(double lo, double hi) {
         ticks.push_back({minor, labelled ? number_label(minor, decade) : ""});
     }
   }
+  // A range that straddles a decade but spans little of either side (e.g. 0.6 to 1.2) would
+  // show one label: label it linearly instead.
+  const auto labelled = std::count_if(ticks.begin(), ticks.end(),
+                                      [](const Tick& t) { return !t.label.empty(); });
+  if (labelled < 3) {
+    ticks.clear();
+    for (Tick tick : linear_ticks(lo, hi))
+      if (tick.value > 0.0) ticks.push_back(tick);
+  }
   return ticks;
 }
 

@@ -34,7 +34,9 @@ for name in "${studies[@]}"; do
       # Fragmented cases (the slab shatters into cells' worth of rubble) have no spacing and
       # their "depth" is that of rubble: left out of the laws, still marked on the figures.
       $crevasse fit "$db" --group cohesion_ratio thickness --exclude-fragmented
-      $crevasse plot "$db" --out "results/${name}_figures" --colour-by thickness
+      # CDFs: the two Π = 0.2 cases at 100 and 800 m (5 and 6 crevasses) and two above Π*.
+      $crevasse plot "$db" --out "results/${name}_figures" --colour-by thickness \
+        --cdf-normalise thickness --cdf-cases 4,40,33,17
       $crevasse calibrate --db "$db" --observations studies/field/observations.json \
         --csv "results/${name}_figures/field_calibration.csv" \
         | tee "results/${name}_figures/field_calibration.txt"

@@ -23,6 +23,16 @@ std::string num(double v) {
   return buf;
 }
 
+// Text as figure text shows it literally ('_', '^' and '\\' are markup there).
+std::string markup_escaped(const std::string& text) {
+  std::string out;
+  for (char ch : text) {
+    if (ch == '_' || ch == '^' || ch == '\\') out += '\\';
+    out += ch;
+  }
+  return out;
+}
+
 std::string group_value_label(const FitGroup& g, const std::optional<double>& v) {
   if (!v) return std::string(g.symbol) + " n/a";
   if (std::string(g.name) == "thickness") return "H_i = " + num(*v) + " m";
@@ -131,11 +141,16 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
   for (Quantity q : kQuantities) {
     const std::string option =
         q == Quantity::spacing ? "--fixed-exponents" : "--fixed-depth-exponents";
-    const StudyFit fit = fit_study(
-        cases, q, group,
+    StudyFitOptions fit_opts =
         fit_options(store, q, group,
                     q == Quantity::spacing ? opt.fixed_exponents : opt.fixed_depth_exponents,
-                    option));
+                    option);
+    // Leave fragmented cases out of the fit when asked, or when the stored fits did.
+    fit_opts.exclude_fragmented = opt.exclude_fragmented;
+    for (const FitRecord& r : read_fit_records(store, quantity_key(q), group.name))
+      if (r.accounting.find("fragmented (excluded)") != std::string::npos)
+        fit_opts.exclude_fragmented = true;
+    const StudyFit fit = fit_study(cases, q, group, fit_opts);
     std::vector<std::pair<double, analysis::RegimePoint>> keyed;  // colour group value, point
     std::map<std::string, std::size_t> missing;
     std::size_t skipped = 0;
@@ -148,7 +163,11 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
       analysis::RegimePoint p;
       p.pi = *x;
       p.group = group_value_label(colour_by, c.group(colour_by));
-      if (const auto y = c.median(q)) {
+      if (fit_opts.exclude_fragmented && c.fragmented && c.median(q)) {
+        p.failed = true;
+        p.missing_reason = "fragmented (not fitted)";
+        ++missing[p.missing_reason];
+      } else if (const auto y = c.median(q)) {
         p.y = *y;
         const auto& quartiles = c.quartiles(q);
         if (quartiles[0] && quartiles[2] && *quartiles[0] > 0.0) {
@@ -178,7 +197,7 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
       for (const auto& [reason, k] : missing) n += k;
       return n;
     }();
-    options.title = study_name + ": median " +
+    options.title = markup_escaped(study_name) + ": median " +
                     (q == Quantity::spacing ? std::string("spacing") : std::string("depth")) +
                     ", " + std::to_string(measured) + " of " + std::to_string(points.size()) +
                     " cases measured";
@@ -230,7 +249,7 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
     samples.push_back(std::move(sample));
   }
   analysis::CdfFigureOptions cdf;
-  cdf.title = study_name + ": crevasse spacings of " + std::to_string(samples.size()) + " case(s)";
+  cdf.title = markup_escaped(study_name) + ": crevasse spacings of " + std::to_string(samples.size()) + " case(s)";
   cdf.x_label = opt.cdf_normalise == "median"      ? "L_p / median L_p of the case"
                 : opt.cdf_normalise == "thickness" ? "L_p/H_i"
                                                    : "L_p [m]";
