@@ -98,6 +98,7 @@ int main(int argc, char** argv) {
   plot->add_option("--fixed-depth-exponents", plot_opt.fixed_depth_exponents, "As crevasse fit");
   plot->add_option("--cdf-cases", plot_opt.cdf_cases, "Case indexes for the spacing CDFs (default: up to 4 spread over the group)")->delimiter(',');
   plot->add_option("--cdf-normalise", plot_opt.cdf_normalise, "Spacing CDFs normalised by: median (of each case), thickness, none");
+  plot->add_option("--add-cases", plot_opt.add_cases, "Other study databases whose cases are drawn too, not fitted (e.g. 3D cases on the 2D diagram)")->delimiter(',');
   plot->add_flag("--exclude-fragmented", plot_opt.exclude_fragmented, "Leave fragmented cases out of the drawn fit, marked on the bottom edge (default: as the fits table was made)");
 
   crevasse::CalibrateCommandOptions calibrate_opt;

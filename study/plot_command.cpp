@@ -137,6 +137,21 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
     throw InputError("--out: cannot create directory " + opt.out_dir +
                      (ec ? " (" + ec.message() + ")" : ""));
 
+  // The cases drawn: the study's own, then those of --add-cases (label prefix, not fitted).
+  std::vector<std::vector<CaseRecord>> added;
+  std::vector<std::string> added_names;
+  for (const std::string& path : opt.add_cases) {
+    Store other = Store::open_reader(path);
+    Statement s(other.handle(), "SELECT name FROM study WHERE id = 1");
+    added_names.push_back(s.step() ? s.text(0) : path);
+    added.push_back(read_case_records(other));
+  }
+  std::vector<std::pair<const CaseRecord*, std::string>> drawn_cases;
+  for (const CaseRecord& c : cases) drawn_cases.emplace_back(&c, "");
+  for (std::size_t k = 0; k < added.size(); ++k)
+    for (const CaseRecord& c : added[k])
+      drawn_cases.emplace_back(&c, markup_escaped(added_names[k]) + ": ");
+
   std::vector<fs::path> written;
   for (Quantity q : kQuantities) {
     const std::string option =
@@ -154,7 +169,8 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
     std::vector<std::pair<double, analysis::RegimePoint>> keyed;  // colour group value, point
     std::map<std::string, std::size_t> missing;
     std::size_t skipped = 0;
-    for (const CaseRecord& c : cases) {
+    for (const auto& [case_ptr, prefix] : drawn_cases) {
+      const CaseRecord& c = *case_ptr;
       const std::optional<double> x = c.group(group);
       if (c.status == "pending" || c.status == "running" || !x || !(*x > 0.0)) {
         ++skipped;
@@ -162,7 +178,7 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
       }
       analysis::RegimePoint p;
       p.pi = *x;
-      p.group = group_value_label(colour_by, c.group(colour_by));
+      p.group = prefix + group_value_label(colour_by, c.group(colour_by));
       if (fit_opts.exclude_fragmented && c.fragmented && c.median(q)) {
         p.failed = true;
         p.missing_reason = "fragmented (not fitted)";

@@ -21,6 +21,9 @@ struct PlotCommandOptions {
   std::string cdf_normalise = "median";  // median, thickness, none
   double level = 0.95;
   bool exclude_fragmented = false;
+  // Other study databases whose cases are drawn on the regime diagrams too (not fitted),
+  // labelled "<their study name>: ...", e.g. 3D cases on their 2D study's diagram.
+  std::vector<std::string> add_cases;
 };
 
 // Returns the files written.

@@ -282,6 +282,34 @@ TEST(FitCli, PlotWritesEveryFigureWithEveryCaseMarked) {
   EXPECT_NE(cdf_svg.find("L_p/H_i"), std::string::npos);
 }
 
+// --add-cases draws another study's cases on the diagram under their study's name, without
+// fitting them (the fit line and its n stay those of the study).
+TEST(FitCli, PlotAddsCasesOfAnotherStudy) {
+  test::ScratchDir dir("fit");
+  write_synthetic_db(dir / "s.db", 8, {100.0}, known_laws(0.05));
+  write_synthetic_db(dir / "other.db", 3, {300.0}, [](const StudyCase&) {
+    FakeResult f;
+    f.spacing_over_h = 50.0;  // far off the law: would move the fit if it were fitted
+    f.depth_over_h = 1.0;
+    return f;
+  });
+  ASSERT_EQ(test::run_cli(dir.path(), "plot s.db --out alone").code, 0);
+  const test::CliResult plot = test::run_cli(dir.path(), "plot s.db --out both --add-cases other.db");
+  ASSERT_EQ(plot.code, 0) << plot.err;
+  EXPECT_NE(plot.out.find("11 case(s) drawn"), std::string::npos) << plot.out;
+  const std::string svg = test::read_file(dir / "both" / "spacing_vs_cohesion_ratio.svg");
+  EXPECT_NE(svg.find("legend: synthetic: H_i = 300 m"), std::string::npos);
+  // The fitted law printed on the figure is the same with and without the added cases.
+  const auto law = [](const std::string& text) {
+    const auto at = text.find("b = ");
+    return at == std::string::npos ? std::string() : text.substr(at, 30);
+  };
+  const std::string alone = test::read_file(dir / "alone" / "spacing_vs_cohesion_ratio.svg");
+  ASSERT_FALSE(law(alone).empty());
+  EXPECT_EQ(law(svg), law(alone));
+  expect_one_line_error(test::run_cli(dir.path(), "plot s.db --out x --add-cases none.db"), "none.db");
+}
+
 double number_after(const std::string& text, const std::string& label) {
   const auto at = text.find(label);
   if (at == std::string::npos) throw std::runtime_error("'" + label + "' not in:\n" + text);
