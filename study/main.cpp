@@ -7,6 +7,7 @@
 #include <string>
 
 #include "engine/error.hpp"
+#include "study/accuracy_command.hpp"
 #include "study/calibrate_command.hpp"
 #include "study/export_command.hpp"
 #include "study/fit_command.hpp"
@@ -119,6 +120,12 @@ int main(int argc, char** argv) {
   predict->add_option("--thickness", predict_opt.thickness_m, "Ice thickness H_i [m]")->required();
   predict->add_option("--level", predict_opt.level, "Confidence level (default 0.95)");
 
+  crevasse::AccuracyCommandOptions accuracy_opt;
+  auto* accuracy = app.add_subcommand("accuracy", "Accuracy against cost of a study over the numerics (studies/accuracy_cost.json): table and figure");
+  accuracy->add_option("db", accuracy_opt.db_path, "Study database")->required();
+  accuracy->add_option("--out", accuracy_opt.out_dir, "Output directory")->required();
+  accuracy->add_option("--reference", accuracy_opt.reference_index, "Case index of the reference run (default: the finest run with a spacing)");
+
   // Parse errors on one line, like every other refusal.
   app.failure_message([](const CLI::App*, const CLI::Error& e) {
     return std::string("crevasse: error: ") + e.what() + "\n";
@@ -143,6 +150,7 @@ int main(int argc, char** argv) {
       return crevasse::calibrate_command(calibrate_opt);
     }
     if (*predict) return crevasse::predict_command(predict_opt);
+    if (*accuracy) return crevasse::accuracy_command(accuracy_opt);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   } catch (const crevasse::InputError& e) {

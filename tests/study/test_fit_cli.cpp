@@ -81,6 +81,8 @@ void write_synthetic_db(const std::filesystem::path& db, int n_pi,
       }
       r.measurement = m;
     }
+    r.wall_s = 1.0 + static_cast<double>(c.index);  // cost grows with the index
+    r.particle_steps = 1000 * (c.index + 1);
     store.record_result(r);
   }
   store.checkpoint();
@@ -308,6 +310,32 @@ TEST(FitCli, PlotAddsCasesOfAnotherStudy) {
   ASSERT_FALSE(law(alone).empty());
   EXPECT_EQ(law(svg), law(alone));
   expect_one_line_error(test::run_cli(dir.path(), "plot s.db --out x --add-cases none.db"), "none.db");
+}
+
+// crevasse accuracy: one table row per finished case, the reference is the case with the most
+// particle-steps that has a spacing, changes are relative to it, and the figure is written.
+TEST(FitCli, AccuracyTableAgainstTheFinestRun) {
+  test::ScratchDir dir("fit");
+  write_synthetic_db(dir / "s.db", 5, {100.0}, [](const StudyCase& c) {
+    FakeResult f;
+    f.spacing_over_h = 1.0 + 0.1 * static_cast<double>(c.index);  // the last (finest) is 1.4
+    f.depth_over_h = 1.0;
+    if (c.index == 0) f.kind = FakeResult::no_crevasse;
+    return f;
+  });
+  const test::CliResult r = test::run_cli(dir.path(), "accuracy s.db --out acc");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* f : {"accuracy_cost.csv", "accuracy_cost.md", "accuracy_cost.png", "accuracy_cost.svg"})
+    EXPECT_TRUE(std::filesystem::exists(dir / "acc" / f)) << f;
+  const std::string md = test::read_file(dir / "acc" / "accuracy_cost.md");
+  EXPECT_NE(md.find("Reference: case 4"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 1.4 | +0.0% |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 1.2 | -14.3% |"), std::string::npos) << md;  // 1.2/1.4 − 1
+  EXPECT_NE(md.find("no crevasse"), std::string::npos) << md;
+  const std::string csv = test::read_file(dir / "acc" / "accuracy_cost.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 6) << csv;  // header + 5 cases
+  expect_one_line_error(test::run_cli(dir.path(), "accuracy s.db --out acc --reference 99"),
+                        "--reference");
 }
 
 double number_after(const std::string& text, const std::string& label) {

@@ -1,0 +1,162 @@
+#include "study/accuracy_command.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+
+#include <nlohmann/json.hpp>
+
+#include "analysis/regime_diagram.hpp"
+#include "engine/error.hpp"
+#include "study/case_results.hpp"
+#include "study/store.hpp"
+#include "study/study_fit.hpp"
+
+namespace crevasse {
+namespace fs = std::filesystem;
+
+namespace {
+
+struct CostRow {
+  const CaseRecord* c = nullptr;
+  double dx_m = 0.0, cfl = 0.0;
+  int ppc_axis = 0;
+  std::optional<double> wall_s, peak_mb;
+  std::optional<long long> steps, particle_steps;
+};
+
+std::string cell(const std::optional<double>& v) { return v ? short_number(*v) : "-"; }
+
+std::string change_pct(const std::optional<double>& v, const std::optional<double>& ref) {
+  if (!v || !ref || *ref == 0.0) return "-";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%+.1f%%", 100.0 * (*v / *ref - 1.0));
+  return buf;
+}
+
+}  // namespace
+
+std::vector<fs::path> accuracy_report(const AccuracyCommandOptions& opt) {
+  Store store = Store::open_reader(opt.db_path);
+  const std::vector<CaseRecord> cases = read_case_records(store);
+  std::map<std::string, CostRow> by_id;
+  {
+    Statement s(store.handle(),
+                "SELECT case_id, scene_json, wall_s, peak_rss_bytes, steps, particle_steps "
+                "FROM cases");
+    while (s.step()) {
+      CostRow r;
+      const auto scene = nlohmann::json::parse(s.text(1));
+      r.dx_m = scene.at("numerics").at("dx").get<double>();
+      r.ppc_axis = scene.at("numerics").at("particles_per_cell_axis").get<int>();
+      r.cfl = scene.at("numerics").at("cfl").get<double>();
+      if (!s.is_null(2)) r.wall_s = s.real(2);
+      if (!s.is_null(3)) r.peak_mb = s.real(3) / 1048576.0;
+      if (!s.is_null(4)) r.steps = s.integer(4);
+      if (!s.is_null(5)) r.particle_steps = s.integer(5);
+      by_id[s.text(0)] = r;
+    }
+  }
+  std::vector<CostRow> rows;
+  for (const CaseRecord& c : cases) {
+    if (c.status != "done") continue;
+    CostRow r = by_id.at(c.case_id);
+    r.c = &c;
+    rows.push_back(r);
+  }
+  if (rows.empty()) throw InputError(opt.db_path + ": no finished case; run the study first");
+
+  // The reference: the given case, else the finest run that has a spacing.
+  const CostRow* ref = nullptr;
+  if (opt.reference_index) {
+    for (const CostRow& r : rows)
+      if (r.c->case_index == *opt.reference_index) ref = &r;
+    if (!ref)
+      throw InputError("--reference: no finished case with index " +
+                       std::to_string(*opt.reference_index) + " in " + opt.db_path);
+  } else {
+    for (const CostRow& r : rows)
+      if (r.c->median(Quantity::spacing) &&
+          (!ref || r.particle_steps.value_or(0) > ref->particle_steps.value_or(0)))
+        ref = &r;
+    if (!ref) throw InputError(opt.db_path + ": no finished case has a spacing to compare with");
+  }
+
+  std::error_code ec;
+  fs::create_directories(opt.out_dir, ec);
+  if (ec || !fs::is_directory(opt.out_dir))
+    throw InputError("--out: cannot create directory " + opt.out_dir);
+  const fs::path csv_path = fs::path(opt.out_dir) / "accuracy_cost.csv";
+  const fs::path md_path = fs::path(opt.out_dir) / "accuracy_cost.md";
+  std::ofstream csv(csv_path), md(md_path);
+  if (!csv || !md) throw InputError("--out: cannot write in " + opt.out_dir);
+  csv << "case_index,dx_m,particles_per_cell_axis,cfl,steps,particle_steps,wall_s,peak_rss_mb,"
+         "crevasses,spacing_median_over_h,depth_median_over_h,spacing_change_vs_reference,"
+         "depth_change_vs_reference,note\n";
+  md << "Reference: case " << ref->c->case_index << " (dx = " << short_number(ref->dx_m)
+     << " m, " << ref->ppc_axis << " particles per cell per axis, CFL " << short_number(ref->cfl)
+     << "). Changes are of the median against the reference's.\n\n"
+     << "| case | dx [m] | ppc/axis | CFL | steps | particle-steps | wall [s] | peak RSS [MB] | "
+        "crevasses | L_p/H_i | change | D_p/H_i | change | note |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  std::vector<analysis::RegimePoint> points;
+  for (const CostRow& r : rows) {
+    const CaseRecord& c = *r.c;
+    const auto l = c.median(Quantity::spacing), d = c.median(Quantity::depth);
+    const auto lr = ref->c->median(Quantity::spacing), dr = ref->c->median(Quantity::depth);
+    std::string note = c.fragmented ? "fragmented" : "";
+    if (!l) note += (note.empty() ? "" : "; ") + c.missing_reason(Quantity::spacing);
+    if (&r == ref) note += (note.empty() ? "" : "; ") + std::string("reference");
+    const std::string steps = r.steps ? std::to_string(*r.steps) : "-";
+    const std::string psteps = r.particle_steps ? short_number(static_cast<double>(*r.particle_steps)) : "-";
+    csv << c.case_index << ',' << r.dx_m << ',' << r.ppc_axis << ',' << r.cfl << ',' << steps << ','
+        << (r.particle_steps ? std::to_string(*r.particle_steps) : "") << ',' << cell(r.wall_s) << ','
+        << cell(r.peak_mb) << ',' << c.crevasse_count << ',' << cell(l) << ',' << cell(d) << ','
+        << change_pct(l, lr) << ',' << change_pct(d, dr) << ",\"" << note << "\"\n";
+    md << "| " << c.case_index << " | " << short_number(r.dx_m) << " | " << r.ppc_axis << " | "
+       << short_number(r.cfl) << " | " << steps << " | " << psteps << " | " << cell(r.wall_s)
+       << " | " << cell(r.peak_mb) << " | " << c.crevasse_count << " | " << cell(l) << " | "
+       << change_pct(l, lr) << " | " << cell(d) << " | " << change_pct(d, dr) << " | " << note
+       << " |\n";
+    if (!r.wall_s || !(*r.wall_s > 0.0)) continue;
+    analysis::RegimePoint p;
+    p.pi = *r.wall_s;
+    p.group = "dx = " + short_number(r.dx_m) + " m";
+    if (l) {
+      p.y = *l;
+      const auto& q = c.quartiles(Quantity::spacing);
+      if (q[0] && q[2] && *q[0] > 0.0) {
+        p.y_q25 = *q[0];
+        p.y_q75 = *q[2];
+      }
+    } else {
+      p.failed = true;
+      p.missing_reason = c.fragmented ? "fragmented" : c.missing_reason(Quantity::spacing);
+    }
+    points.push_back(p);
+  }
+  std::stable_sort(points.begin(), points.end(), [](const auto& a, const auto& b) {
+    return std::stod(a.group.substr(5)) > std::stod(b.group.substr(5));
+  });
+  analysis::RegimeDiagramOptions options;
+  options.title = "accuracy against cost: median spacing of each run";
+  options.x_label = "wall time [s] (one engine thread)";
+  options.x_symbol = "t";
+  const analysis::Figure figure = analysis::regime_diagram(points, {}, options);
+  const fs::path stem = fs::path(opt.out_dir) / "accuracy_cost";
+  figure.write_png(stem.string() + ".png");
+  figure.write_svg(stem.string() + ".svg");
+  return {csv_path, md_path, stem.string() + ".png", stem.string() + ".svg"};
+}
+
+int accuracy_command(const AccuracyCommandOptions& opt) {
+  const auto files = accuracy_report(opt);
+  std::ifstream md(files[1]);
+  std::printf("%s", std::string(std::istreambuf_iterator<char>(md), {}).c_str());
+  std::printf("wrote %zu file(s) to %s\n", files.size(), opt.out_dir.c_str());
+  return 0;
+}
+
+}  // namespace crevasse

@@ -1,0 +1,25 @@
+#pragma once
+// `crevasse accuracy DB --out DIR`: accuracy against cost of a study that varies the numerics
+// (studies/accuracy_cost.json, SPEC §6, issue 6): per case the grid spacing, particles per cell,
+// CFL number, steps, particle-steps, wall time and peak memory, the median spacing and depth
+// and their change against a reference case (by default the finest: the most particle-steps
+// among the cases with a spacing). Writes accuracy_cost.csv, accuracy_cost.md (the table) and
+// accuracy_cost.png/.svg (median L_p/H_i with quartile bars against wall time, one marker per
+// grid spacing; cases without a spacing on the bottom edge).
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace crevasse {
+
+struct AccuracyCommandOptions {
+  std::string db_path;
+  std::string out_dir;
+  std::optional<long long> reference_index;  // case_index of the reference case
+};
+
+std::vector<std::filesystem::path> accuracy_report(const AccuracyCommandOptions& opt);
+int accuracy_command(const AccuracyCommandOptions& opt);
+
+}  // namespace crevasse
