@@ -7,10 +7,11 @@
 #   bash scripts/run_studies.sh                 # every study, in the order below
 #   bash scripts/run_studies.sh slope three_d   # only these
 #
-# Measured cost on the 2-core development VM (one case per core): spacing_vs_cohesion about
-# 45 min of case wall time (45 cases), slope 12 min, step_length 16 min, three_d about 45 min
-# (3 cases of about 15 min), accuracy_cost about 50 min (one case at a time, so that each
-# case's wall time and peak memory are its own).
+# Measured cost on the 2-core development VM, in case wall time (docs/study_format.md,
+# "Shipped studies"): spacing_vs_cohesion 36 min, spacing_replicas about 15 min,
+# spacing_resolution about 30 min, slope 5 min, step_length 6 min, three_d 31 min (3 cases),
+# accuracy_cost about 35 min (one case at a time, so that each case's wall time and peak memory
+# are its own).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 crevasse=./build/study/crevasse
@@ -22,7 +23,8 @@ fi
 
 studies=("$@")
 if [[ ${#studies[@]} -eq 0 ]]; then
-  studies=(spacing_vs_cohesion slope step_length three_d accuracy_cost)
+  studies=(spacing_vs_cohesion spacing_replicas spacing_resolution slope step_length three_d
+           accuracy_cost)
 fi
 
 for name in "${studies[@]}"; do
@@ -50,7 +52,18 @@ for name in "${studies[@]}"; do
       $crevasse plot "$db" --out "results/${name}_figures" --group step_length_ratio \
         --colour-by cohesion_ratio
       ;;
-    three_d | accuracy_cost)
+    spacing_replicas | spacing_resolution)
+      # Compared case by case with spacing_vs_cohesion (results/README.md); the main study's
+      # diagram with these cases added:
+      $crevasse plot results/spacing_vs_cohesion.db --out "results/${name}_figures" \
+        --colour-by thickness --add-cases "$db"
+      ;;
+    three_d)
+      # The 3D cases on the diagram of the 2D study at the same groups (quick).
+      $crevasse plot results/quick.db --out "results/${name}_figures" --add-cases "$db"
+      ;;
+    accuracy_cost)
+      $crevasse accuracy "$db" --out "results/${name}"
       ;;
   esac
 done
