@@ -121,6 +121,39 @@ void add_annotations(Figure& figure, const std::vector<std::string>& lines, Lege
   }
 }
 
+// With the legend in the upper left, a point high on the left would hide under it. The legend
+// box is estimated (its height grows with the entries: groups, missing-value reasons, and the
+// fit's line, band and breakpoint); when a point's marker or quartile bar reaches into it, the
+// top of the y axis is raised so that every point lies below the box.
+void keep_points_clear_of_legend(Figure& figure, const std::vector<RegimePoint>& points,
+                                 std::size_t entries, const RegimeDiagramOptions& options) {
+  if (options.legend != LegendPosition::upper_left) return;
+  double x_lo = INFINITY, x_hi = -INFINITY, y_lo = INFINITY, y_hi = -INFINITY;
+  for (const RegimePoint& p : points) {
+    x_lo = std::min(x_lo, std::log10(p.pi));
+    x_hi = std::max(x_hi, std::log10(p.pi));
+    if (p.failed) continue;
+    const double top = std::isfinite(p.y_q75) ? std::max(p.y, p.y_q75) : p.y;
+    const double bottom = std::isfinite(p.y_q25) ? std::min(p.y, p.y_q25) : p.y;
+    y_lo = std::min(y_lo, std::log10(bottom));
+    y_hi = std::max(y_hi, std::log10(top));
+  }
+  if (!(y_hi > y_lo) || !(x_hi > x_lo)) return;
+  const double box_height = std::min(0.7, 0.04 + 0.065 * static_cast<double>(entries + 1));
+  const double box_width = 0.45;
+  bool covered = false;
+  for (const RegimePoint& p : points) {
+    if (p.failed) continue;
+    const double fx = (std::log10(p.pi) - x_lo) / (x_hi - x_lo);
+    const double top = std::isfinite(p.y_q75) ? std::max(p.y, p.y_q75) : p.y;
+    const double fy = (std::log10(top) - y_lo) / (y_hi - y_lo);
+    if (fx < box_width && fy > 1.0 - box_height - 0.05) covered = true;
+  }
+  if (!covered) return;
+  const double top = y_lo + (y_hi - y_lo) / (1.0 - box_height);
+  figure.set_y_axis(options.y_label, AxisScale::log10, std::nullopt, std::pow(10.0, top));
+}
+
 }  // namespace
 
 Figure regime_diagram(const std::vector<RegimePoint>& points, const RegimeFit& fit,
@@ -200,6 +233,8 @@ Figure regime_diagram(const std::vector<RegimePoint>& points, const RegimeFit& f
     }
   }
   add_annotations(figure, annotations, options.legend);
+  keep_points_clear_of_legend(figure, points, groups.size() + reasons.size() + annotations.size(),
+                              options);
   return figure;
 }
 

@@ -213,7 +213,9 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
       for (const auto& [reason, k] : missing) n += k;
       return n;
     }();
-    options.title = markup_escaped(study_name) + ": median " +
+    std::string shown = markup_escaped(study_name);
+    for (const std::string& name : added_names) shown += " + " + markup_escaped(name);
+    options.title = shown + ": median " +
                     (q == Quantity::spacing ? std::string("spacing") : std::string("depth")) +
                     ", " + std::to_string(measured) + " of " + std::to_string(points.size()) +
                     " cases measured";
