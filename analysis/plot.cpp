@@ -370,6 +370,8 @@ class Renderer {
       widest = std::max(widest, text_width(cr_, tick.label, kTickFontPt));
     left_ = 12.0 + kLabelFontPt * 1.4 + widest + 8.0;
     right_ = figure_.width_pt() - 16.0;
+    if (figure_.legend_position() == LegendPosition::outside_right && !figure_.legend().empty())
+      right_ -= legend_size().first + 8.0;
     top_ = figure_.title().empty() ? 14.0 : 14.0 + kTitleFontPt * 1.6;
     bottom_ = figure_.height_pt() - (12.0 + kLabelFontPt * 1.4 + kTickFontPt * 1.8);
     if (right_ - left_ < 40.0 || bottom_ - top_ < 40.0) {
@@ -573,22 +575,33 @@ class Renderer {
     }
   }
 
-  void draw_legend() {
+  // Width and height of the legend box [pt].
+  std::pair<double, double> legend_size() const {
     const auto& entries = figure_.legend();
-    if (entries.empty() || figure_.legend_position() == LegendPosition::none) return;
     const double row = kLegendFontPt * 1.6, sample = 22.0, pad = 6.0;
     double widest = 0.0;
     for (const auto& entry : entries)
       widest = std::max(widest, text_width(cr_, entry.label, kLegendFontPt));
-    const double width = pad + sample + 6.0 + widest + pad;
-    const double height = pad + row * static_cast<double>(entries.size()) + pad - 0.4 * row;
+    return {pad + sample + 6.0 + widest + pad,
+            pad + row * static_cast<double>(entries.size()) + pad - 0.4 * row};
+  }
+
+  void draw_legend() {
+    const auto& entries = figure_.legend();
+    if (entries.empty() || figure_.legend_position() == LegendPosition::none) return;
+    const double row = kLegendFontPt * 1.6, sample = 22.0, pad = 6.0;
+    const auto [width, height] = legend_size();
     const LegendPosition position = figure_.legend_position();
     const bool at_left =
         position == LegendPosition::upper_left || position == LegendPosition::lower_left;
-    const bool at_top =
-        position == LegendPosition::upper_left || position == LegendPosition::upper_right;
-    const double x0 = at_left ? left_ + 8.0 : right_ - 8.0 - width;
-    const double y0 = at_top ? top_ + 8.0 : bottom_ - 8.0 - height;
+    const bool at_top = position == LegendPosition::upper_left ||
+                        position == LegendPosition::upper_right ||
+                        position == LegendPosition::outside_right;
+    const double x0 = position == LegendPosition::outside_right ? right_ + 8.0
+                      : at_left                                  ? left_ + 8.0
+                                                                 : right_ - 8.0 - width;
+    const double y0 = at_top ? top_ + (position == LegendPosition::outside_right ? 0.0 : 8.0)
+                             : bottom_ - 8.0 - height;
     cairo_set_dash(cr_, nullptr, 0, 0.0);
     cairo_rectangle(cr_, x0, y0, width, height);
     set_color(cr_, {1.0, 1.0, 1.0, 0.85});

@@ -39,7 +39,8 @@ struct LineStyle {
   std::vector<double> dash_pt;  // empty: solid
 };
 
-enum class LegendPosition { upper_left, upper_right, lower_left, lower_right, none };
+// outside_right: beside the axes, which give up the legend's width (for long legends).
+enum class LegendPosition { upper_left, upper_right, lower_left, lower_right, none, outside_right };
 enum class TextAnchor { left, centre, right };
 
 struct TextStyle {

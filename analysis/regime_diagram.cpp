@@ -161,17 +161,35 @@ Figure regime_diagram(const std::vector<RegimePoint>& points, const RegimeFit& f
   if (points.empty() && std::holds_alternative<std::monostate>(fit)) {
     throw std::invalid_argument("regime diagram: no points and no fit; nothing to draw");
   }
-  Figure figure(options.width_pt, options.height_pt);
-  figure.set_title(options.title);
-  figure.set_x_axis(options.x_label, AxisScale::log10);
-  figure.set_y_axis(options.y_label, AxisScale::log10);
-  figure.set_legend_position(options.legend);
-
   // Groups in order of first appearance, so colours follow the caller's ordering.
   std::vector<std::string> groups;
   for (const RegimePoint& p : points) {
     if (std::find(groups.begin(), groups.end(), p.group) == groups.end()) groups.push_back(p.group);
   }
+  // A legend of more than 7 entries (groups, missing-value reasons, the fit's 2 or 4) would
+  // cover the data: it goes beside the axes, on a figure widened to keep the axes' size.
+  std::size_t reason_count = 0;
+  {
+    std::vector<std::string> seen;
+    for (const RegimePoint& p : points)
+      if (p.failed && std::find(seen.begin(), seen.end(), p.missing_reason) == seen.end())
+        seen.push_back(p.missing_reason);
+    reason_count = seen.size();
+  }
+  const std::size_t fit_entries = std::holds_alternative<BrokenLineFit>(fit)  ? 4
+                                  : std::holds_alternative<PowerLawFit>(fit) ? 2
+                                                                             : 0;
+  RegimeDiagramOptions layout = options;
+  if (options.legend == LegendPosition::upper_left &&
+      groups.size() + reason_count + fit_entries > 7) {
+    layout.legend = LegendPosition::outside_right;
+    layout.width_pt += 190.0;
+  }
+  Figure figure(layout.width_pt, layout.height_pt);
+  figure.set_title(options.title);
+  figure.set_x_axis(options.x_label, AxisScale::log10);
+  figure.set_y_axis(options.y_label, AxisScale::log10);
+  figure.set_legend_position(layout.legend);
   for (std::size_t i = 0; i < points.size(); ++i) {
     const RegimePoint& p = points[i];
     if (!std::isfinite(p.pi) || p.pi <= 0.0 || (!p.failed && (!std::isfinite(p.y) || p.y <= 0.0))) {
@@ -232,9 +250,9 @@ Figure regime_diagram(const std::vector<RegimePoint>& points, const RegimeFit& f
       in_legend = true;
     }
   }
-  add_annotations(figure, annotations, options.legend);
-  keep_points_clear_of_legend(figure, points, groups.size() + reasons.size() + annotations.size(),
-                              options);
+  add_annotations(figure, annotations, layout.legend);
+  keep_points_clear_of_legend(figure, points, groups.size() + reasons.size() + fit_entries,
+                              layout);
   return figure;
 }
 

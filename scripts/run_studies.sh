@@ -8,8 +8,8 @@
 #   bash scripts/run_studies.sh slope three_d   # only these
 #
 # Measured cost on the 2-core development VM, in case wall time (docs/study_format.md,
-# "Shipped studies"): spacing_vs_cohesion 36 min, spacing_replicas about 15 min,
-# spacing_resolution about 30 min, slope 5 min, step_length 6 min, three_d 31 min (3 cases),
+# "Shipped studies"): spacing_vs_cohesion 36 min, spacing_replicas 9 min,
+# spacing_resolution 23 min, slope 5 min, step_length 6 min, three_d 31 min (3 cases),
 # accuracy_cost 28 min (one case at a time, so that each case's wall time and peak memory
 # are its own).
 set -euo pipefail

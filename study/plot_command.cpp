@@ -218,7 +218,7 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
     options.title = shown + ": median " +
                     (q == Quantity::spacing ? std::string("spacing") : std::string("depth")) +
                     ", " + std::to_string(measured) + " of " + std::to_string(points.size()) +
-                    " cases measured";
+                    (added_names.empty() ? " cases measured" : " cases");
     options.y_label = quantity_symbol(q);
     options.x_label = group.axis_label;
     options.x_symbol = group.symbol;

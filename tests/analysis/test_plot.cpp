@@ -176,5 +176,34 @@ TEST(RegimeCdf, DrawsOneStaircasePerSample) {
   EXPECT_THROW(empirical_cdf_figure({{"nan", {1.0, std::nan("")}}}), std::invalid_argument);
 }
 
+// Legend placement: a point high on the left lifts the top of the y axis clear of the
+// upper-left legend; a legend of more than 7 entries moves beside the axes on a wider figure;
+// a diagram with neither keeps the automatic range and the default width.
+TEST(RegimeDiagram, LegendKeepsClearOfThePoints) {
+  RegimeDiagramOptions options;
+  std::vector<RegimePoint> low_left = {{0.1, 1.0, NAN, NAN, "a"}, {1.0, 2.0, NAN, NAN, "a"}};
+  const Figure plain = regime_diagram(low_left, {}, options);
+  EXPECT_FALSE(plain.y_axis().max.has_value());
+  EXPECT_EQ(plain.legend_position(), LegendPosition::upper_left);
+  EXPECT_DOUBLE_EQ(plain.width_pt(), options.width_pt);
+
+  std::vector<RegimePoint> high_left = {{0.1, 2.0, NAN, NAN, "a"}, {1.0, 1.0, NAN, NAN, "a"}};
+  const Figure lifted = regime_diagram(high_left, {}, options);
+  ASSERT_TRUE(lifted.y_axis().max.has_value());
+  EXPECT_GT(*lifted.y_axis().max, 2.0);
+
+  std::vector<RegimePoint> many;
+  for (int g = 0; g < 8; ++g)
+    many.push_back({0.1 * (g + 1), 1.0 + 0.1 * g, NAN, NAN, "group " + std::to_string(g)});
+  const Figure wide = regime_diagram(many, {}, options);
+  EXPECT_EQ(wide.legend_position(), LegendPosition::outside_right);
+  EXPECT_GT(wide.width_pt(), options.width_pt);
+  EXPECT_FALSE(wide.y_axis().max.has_value());
+  const auto png = std::filesystem::temp_directory_path() / "crevasse_legend_outside.png";
+  wide.write_png(png.string());
+  EXPECT_GT(std::filesystem::file_size(png), 1000u);
+  std::filesystem::remove(png);
+}
+
 }  // namespace
 }  // namespace crevasse::analysis
