@@ -10,6 +10,7 @@
 # Measured cost on the 2-core development VM, in case wall time (docs/study_format.md,
 # "Shipped studies"): spacing_vs_cohesion 36 min, spacing_replicas 9 min,
 # spacing_resolution 23 min, slope 5 min, step_length 6 min, three_d 31 min (3 cases),
+# two_d_long 3 min, three_d_long about 2 h (2 cases; not run yet),
 # accuracy_cost 28 min (one case at a time, so that each case's wall time and peak memory
 # are its own).
 set -euo pipefail
@@ -24,7 +25,7 @@ fi
 studies=("$@")
 if [[ ${#studies[@]} -eq 0 ]]; then
   studies=(spacing_vs_cohesion spacing_replicas spacing_resolution slope step_length three_d
-           accuracy_cost)
+           two_d_long three_d_long accuracy_cost)
 fi
 
 for name in "${studies[@]}"; do
@@ -61,6 +62,12 @@ for name in "${studies[@]}"; do
     three_d)
       # The 3D cases on the diagram of the 2D study at the same groups (quick).
       $crevasse plot results/quick.db --out "results/${name}_figures" --add-cases "$db"
+      ;;
+    three_d_long)
+      # The long-window 3D cases on the diagram of their 2D counterpart (run two_d_long first).
+      $crevasse plot results/two_d_long.db --out "results/${name}_figures" --add-cases "$db"
+      ;;
+    two_d_long)
       ;;
     accuracy_cost)
       $crevasse accuracy "$db" --out "results/${name}"
