@@ -709,6 +709,15 @@ void check_sizes(std::size_t x, std::size_t y, const char* what) {
 
 }  // namespace
 
+std::string escape_markup(const std::string& text) {
+  std::string out;
+  for (char ch : text) {
+    if (ch == '_' || ch == '^' || ch == '\\') out += '\\';
+    out += ch;
+  }
+  return out;
+}
+
 Color palette_color(std::size_t index) {
   static constexpr Color kOkabeIto[] = {
       {0.000, 0.447, 0.698, 1.0},  // blue

@@ -43,6 +43,9 @@ struct LineStyle {
 enum class LegendPosition { upper_left, upper_right, lower_left, lower_right, none, outside_right };
 enum class TextAnchor { left, centre, right };
 
+// `text` escaped so that figure text shows it literally (names of studies, files, ...).
+std::string escape_markup(const std::string& text);
+
 struct TextStyle {
   double size_pt = 10.0;
   Color color;

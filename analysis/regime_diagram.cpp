@@ -168,20 +168,19 @@ Figure regime_diagram(const std::vector<RegimePoint>& points, const RegimeFit& f
   }
   // A legend of more than 7 entries (groups, missing-value reasons, the fit's 2 or 4) would
   // cover the data: it goes beside the axes, on a figure widened to keep the axes' size.
-  std::size_t reason_count = 0;
-  {
-    std::vector<std::string> seen;
-    for (const RegimePoint& p : points)
-      if (p.failed && std::find(seen.begin(), seen.end(), p.missing_reason) == seen.end())
-        seen.push_back(p.missing_reason);
-    reason_count = seen.size();
+  // Points without a value after all groups, so the legend lists the groups first; one
+  // marker shape per reason, the colour of the point's group.
+  std::vector<std::string> reasons;
+  for (const RegimePoint& p : points) {
+    if (p.failed && std::find(reasons.begin(), reasons.end(), p.missing_reason) == reasons.end())
+      reasons.push_back(p.missing_reason);
   }
   const std::size_t fit_entries = std::holds_alternative<BrokenLineFit>(fit)  ? 4
                                   : std::holds_alternative<PowerLawFit>(fit) ? 2
                                                                              : 0;
   RegimeDiagramOptions layout = options;
   if (options.legend == LegendPosition::upper_left &&
-      groups.size() + reason_count + fit_entries > 7) {
+      groups.size() + reasons.size() + fit_entries > 7) {
     layout.legend = LegendPosition::outside_right;
     layout.width_pt += 190.0;
   }
@@ -208,13 +207,6 @@ Figure regime_diagram(const std::vector<RegimePoint>& points, const RegimeFit& f
     annotations = add_broken_line(figure, *broken, options);
   }
 
-  // Points without a value after all groups, so the legend lists the groups first; one
-  // marker shape per reason, the colour of the point's group.
-  std::vector<std::string> reasons;
-  for (const RegimePoint& p : points) {
-    if (p.failed && std::find(reasons.begin(), reasons.end(), p.missing_reason) == reasons.end())
-      reasons.push_back(p.missing_reason);
-  }
   for (std::size_t g = 0; g < groups.size(); ++g) {
     std::vector<double> x, y, x_bar, lo, hi;
     for (const RegimePoint& p : points) {

@@ -783,12 +783,22 @@ void Simulation<Dim>::update_time_step() {
         return a;
       });
   const double dx = scene_.dx;
+  // Where an error happened (built only on the error paths below; this runs every step).
   // During settling the step count and time restart at 0 afterwards: say so.
-  const std::string when = (settling_ ? "settling (before t = 0), step " : "step ") +
-                           std::to_string(steps_) + ", t = " + std::to_string(time_);
+  const auto when = [&] {
+    return (settling_ ? "settling (before t = 0), step " : "step ") + std::to_string(steps_) +
+           ", t = " + std::to_string(time_);
+  };
+  // The particle with the largest speed (only on the error paths below).
+  const auto fastest = [&] {
+    std::size_t worst = 0;
+    for (std::size_t p = 0; p < P.size(); ++p)
+      if (P.v[p].squaredNorm() >= acc.v2) worst = p;
+    return worst;
+  };
   if (acc.bad >= 0) {
     const auto p = static_cast<std::size_t>(acc.bad);
-    throw SimulationError(when +
+    throw SimulationError(when() +
                           " s: particle " + std::to_string(p) + " at " +
                           describe_position(P.x[p].data(), Dim) +
                           " has a non-finite velocity or stress (numerical instability; lower "
@@ -798,10 +808,8 @@ void Simulation<Dim>::update_time_step() {
   if (steps_ > 0 && vmax * dt_ > dx) {
     // The CFL step bounds |v|·dt by cfl·dx with the velocities of the previous step; a particle
     // that moved more than a whole cell in one step means the update has blown up.
-    std::size_t worst = 0;
-    for (std::size_t p = 0; p < P.size(); ++p)
-      if (P.v[p].squaredNorm() >= acc.v2) worst = p;
-    throw SimulationError(when + " s: particle " + std::to_string(worst) + " at " +
+    const std::size_t worst = fastest();
+    throw SimulationError(when() + " s: particle " + std::to_string(worst) + " at " +
                           describe_position(P.x[worst].data(), Dim) + " moved " +
                           std::to_string(vmax * dt_) + " m in one step (> dx = " +
                           std::to_string(dx) + " m) at speed " + std::to_string(vmax) +
@@ -811,10 +819,8 @@ void Simulation<Dim>::update_time_step() {
   if (speed_bound_ > 0.0 && vmax > speed_bound_) {
     // A mild instability (CFL just above its limit) grows particle speeds without ever moving a
     // particle a whole cell in one step; bound them by the physics instead (speed_bound_).
-    std::size_t worst = 0;
-    for (std::size_t p = 0; p < P.size(); ++p)
-      if (P.v[p].squaredNorm() >= acc.v2) worst = p;
-    throw SimulationError(when + " s: particle " + std::to_string(worst) + " at " +
+    const std::size_t worst = fastest();
+    throw SimulationError(when() + " s: particle " + std::to_string(worst) + " at " +
                           describe_position(P.x[worst].data(), Dim) + " has speed " +
                           std::to_string(vmax) + " m/s, above the physical bound " +
                           std::to_string(speed_bound_) +

@@ -5,12 +5,14 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "analysis/regime_diagram.hpp"
 #include "engine/error.hpp"
 #include "study/case_results.hpp"
+#include "study/csv_file.hpp"
 #include "study/store.hpp"
 #include "study/study_fit.hpp"
 
@@ -38,7 +40,7 @@ std::string change_pct(const std::optional<double>& v, const std::optional<doubl
 
 }  // namespace
 
-std::vector<fs::path> accuracy_report(const AccuracyCommandOptions& opt) {
+std::vector<fs::path> accuracy_report(const AccuracyCommandOptions& opt, std::string* table) {
   Store store = Store::open_reader(opt.db_path);
   const std::vector<CaseRecord> cases = read_case_records(store);
   std::map<std::string, CostRow> by_id;
@@ -67,6 +69,9 @@ std::vector<fs::path> accuracy_report(const AccuracyCommandOptions& opt) {
     rows.push_back(r);
   }
   if (rows.empty()) throw InputError(opt.db_path + ": no finished case; run the study first");
+  // Coarsest grid first (the figure's colours and legend follow this order), then case order.
+  std::stable_sort(rows.begin(), rows.end(),
+                   [](const CostRow& a, const CostRow& b) { return a.dx_m > b.dx_m; });
 
   // The reference: the given case, else the finest run that has a spacing.
   const CostRow* ref = nullptr;
@@ -90,15 +95,15 @@ std::vector<fs::path> accuracy_report(const AccuracyCommandOptions& opt) {
     throw InputError("--out: cannot create directory " + opt.out_dir);
   const fs::path csv_path = fs::path(opt.out_dir) / "accuracy_cost.csv";
   const fs::path md_path = fs::path(opt.out_dir) / "accuracy_cost.md";
-  std::ofstream csv(csv_path), md(md_path);
-  if (!csv || !md) throw InputError("--out: cannot write in " + opt.out_dir);
-  csv << "case_index,dx_m,particles_per_cell_axis,cfl,steps,particle_steps,wall_s,peak_rss_mb,"
-         "crevasses,spacing_median_over_h,depth_median_over_h,spacing_change_vs_reference,"
-         "depth_change_vs_reference,note\n";
+  CsvFile csv(csv_path, "--out");
+  csv.row({"case_index", "dx_m", "particles_per_cell_axis", "cfl", "steps", "particle_steps",
+           "wall_s", "peak_rss_mib", "crevasses", "spacing_median_over_h", "depth_median_over_h",
+           "spacing_change_vs_reference", "depth_change_vs_reference", "note"});
+  std::ostringstream md;
   md << "Reference: case " << ref->c->case_index << " (dx = " << short_number(ref->dx_m)
      << " m, " << ref->ppc_axis << " particles per cell per axis, CFL " << short_number(ref->cfl)
      << "). Changes are of the median against the reference's.\n\n"
-     << "| case | dx [m] | ppc/axis | CFL | steps | particle-steps | wall [s] | peak RSS [MB] | "
+     << "| case | dx [m] | ppc/axis | CFL | steps | particle-steps | wall [s] | peak RSS [MiB] | "
         "crevasses | L_p/H_i | change | D_p/H_i | change | note |\n"
      << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   std::vector<analysis::RegimePoint> points;
@@ -111,10 +116,10 @@ std::vector<fs::path> accuracy_report(const AccuracyCommandOptions& opt) {
     if (&r == ref) note += (note.empty() ? "" : "; ") + std::string("reference");
     const std::string steps = r.steps ? std::to_string(*r.steps) : "-";
     const std::string psteps = r.particle_steps ? short_number(static_cast<double>(*r.particle_steps)) : "-";
-    csv << c.case_index << ',' << r.dx_m << ',' << r.ppc_axis << ',' << r.cfl << ',' << steps << ','
-        << (r.particle_steps ? std::to_string(*r.particle_steps) : "") << ',' << cell(r.wall_s) << ','
-        << cell(r.peak_mb) << ',' << c.crevasse_count << ',' << cell(l) << ',' << cell(d) << ','
-        << change_pct(l, lr) << ',' << change_pct(d, dr) << ",\"" << note << "\"\n";
+    csv.row({std::to_string(c.case_index), short_number(r.dx_m), std::to_string(r.ppc_axis),
+             short_number(r.cfl), steps, r.particle_steps ? std::to_string(*r.particle_steps) : "",
+             cell(r.wall_s), cell(r.peak_mb), std::to_string(c.crevasse_count), cell(l), cell(d),
+             change_pct(l, lr), change_pct(d, dr), note});
     md << "| " << c.case_index << " | " << short_number(r.dx_m) << " | " << r.ppc_axis << " | "
        << short_number(r.cfl) << " | " << steps << " | " << psteps << " | " << cell(r.wall_s)
        << " | " << cell(r.peak_mb) << " | " << c.crevasse_count << " | " << cell(l) << " | "
@@ -137,24 +142,26 @@ std::vector<fs::path> accuracy_report(const AccuracyCommandOptions& opt) {
     }
     points.push_back(p);
   }
-  std::stable_sort(points.begin(), points.end(), [](const auto& a, const auto& b) {
-    return std::stod(a.group.substr(5)) > std::stod(b.group.substr(5));
-  });
   analysis::RegimeDiagramOptions options;
   options.title = "accuracy against cost: median spacing of each run";
   options.x_label = "wall time [s] (one engine thread)";
   options.x_symbol = "t";
+  csv.close();
+  std::ofstream md_file(md_path);
+  md_file << md.str();
+  if (!md_file) throw InputError("--out: cannot write " + md_path.string());
   const analysis::Figure figure = analysis::regime_diagram(points, {}, options);
   const fs::path stem = fs::path(opt.out_dir) / "accuracy_cost";
   figure.write_png(stem.string() + ".png");
   figure.write_svg(stem.string() + ".svg");
+  if (table) *table = md.str();
   return {csv_path, md_path, stem.string() + ".png", stem.string() + ".svg"};
 }
 
 int accuracy_command(const AccuracyCommandOptions& opt) {
-  const auto files = accuracy_report(opt);
-  std::ifstream md(files[1]);
-  std::printf("%s", std::string(std::istreambuf_iterator<char>(md), {}).c_str());
+  std::string table;
+  const auto files = accuracy_report(opt, &table);
+  std::printf("%s", table.c_str());
   std::printf("wrote %zu file(s) to %s\n", files.size(), opt.out_dir.c_str());
   return 0;
 }

@@ -19,7 +19,9 @@ struct AccuracyCommandOptions {
   std::optional<long long> reference_index;  // case_index of the reference case
 };
 
-std::vector<std::filesystem::path> accuracy_report(const AccuracyCommandOptions& opt);
+// Returns the files written; `table`, when given, receives the Markdown table.
+std::vector<std::filesystem::path> accuracy_report(const AccuracyCommandOptions& opt,
+                                                   std::string* table = nullptr);
 int accuracy_command(const AccuracyCommandOptions& opt);
 
 }  // namespace crevasse

@@ -9,6 +9,7 @@
 #include "analysis/calibration.hpp"
 #include "engine/error.hpp"
 #include "study/case_results.hpp"
+#include "study/csv_file.hpp"
 #include "study/field_observations.hpp"
 #include "study/fits_table.hpp"
 #include "study/store.hpp"
@@ -199,19 +200,13 @@ int calibrate_observations(const CalibrateCommandOptions& opt) {
   std::printf("observations: %s (%zu sites)\n\n", opt.observations_path.c_str(), sites.size());
   std::printf("%-32s %9s %-20s %8s %7s  %-26s %10s %-22s %-24s %s\n", "site", "L_p[m]", "spread used",
               "H_i[m]", "L_p/H_i", "regime", "c[kPa]", "interval[kPa]", "Pi [interval]", "in regime / why not");
-  std::FILE* csv = nullptr;
+  std::optional<CsvFile> csv;
   if (!opt.csv_path.empty()) {
-    csv = std::fopen(opt.csv_path.c_str(), "w");
-    if (!csv) throw InputError("--csv: cannot write " + opt.csv_path);
-    std::fprintf(csv,
-                 "id,site,spacing_m,spacing_statistic,spread_used,spread_q25_m,spread_q75_m,thickness_m,"
-                 "regime,c_kpa,c_lo_kpa,c_hi_kpa,pi,pi_lo,pi_hi,pi_in_regime,refusal,reference\n");
+    csv.emplace(opt.csv_path);
+    csv->row({"id", "site", "spacing_m", "spacing_statistic", "spread_used", "spread_q25_m",
+              "spread_q75_m", "thickness_m", "regime", "c_kpa", "c_lo_kpa", "c_hi_kpa", "pi",
+              "pi_lo", "pi_hi", "pi_in_regime", "refusal", "reference"});
   }
-  const auto quoted = [](const std::string& t) {
-    std::string q = "\"";
-    for (char ch : t) q += ch == '"' ? std::string("\"\"") : std::string(1, ch);
-    return q + "\"";
-  };
   const auto opt_num = [](const std::optional<double>& v) { return v ? short_number(*v) : std::string(); };
   for (const FieldObservation& site : sites) {
     std::string spread;
@@ -260,23 +255,21 @@ int calibrate_observations(const CalibrateCommandOptions& opt) {
                   regime.c_str(), c.c_str(), interval.c_str(), pi.c_str(), verdict.c_str());
       if (csv) {
         const analysis::CohesionEstimate* e = any ? &*answers[k].estimate : nullptr;
-        std::fprintf(
-            csv, "%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s\n", quoted(site.id).c_str(),
-            quoted(site.site).c_str(), short_number(site.spacing_m).c_str(), site.statistic.c_str(),
-            quoted(spread).c_str(), opt_num(obs.spacing_q25_m).c_str(), opt_num(obs.spacing_q75_m).c_str(),
-            opt_num(site.thickness_m).c_str(), quoted(any ? regime : "").c_str(),
-            e ? short_number(e->tensile_strength_pa / 1e3).c_str() : "",
-            e ? short_number(e->interval_pa.lower / 1e3).c_str() : "",
-            e ? short_number(e->interval_pa.upper / 1e3).c_str() : "",
-            e && e->cohesion_ratio_pi ? short_number(e->cohesion_ratio_pi->value).c_str() : "",
-            e && e->cohesion_ratio_pi ? short_number(e->cohesion_ratio_pi->interval.lower).c_str() : "",
-            e && e->cohesion_ratio_pi ? short_number(e->cohesion_ratio_pi->interval.upper).c_str() : "",
-            e && e->pi_in_regime_range ? (*e->pi_in_regime_range ? "yes" : "no") : "",
-            quoted(any ? "" : refusals).c_str(), quoted(site.reference).c_str());
+        const bool has_pi = e && e->cohesion_ratio_pi;
+        csv->row({site.id, site.site, short_number(site.spacing_m), site.statistic, spread,
+                  opt_num(obs.spacing_q25_m), opt_num(obs.spacing_q75_m), opt_num(site.thickness_m),
+                  any ? regime : "", e ? short_number(e->tensile_strength_pa / 1e3) : "",
+                  e ? short_number(e->interval_pa.lower / 1e3) : "",
+                  e ? short_number(e->interval_pa.upper / 1e3) : "",
+                  has_pi ? short_number(e->cohesion_ratio_pi->value) : "",
+                  has_pi ? short_number(e->cohesion_ratio_pi->interval.lower) : "",
+                  has_pi ? short_number(e->cohesion_ratio_pi->interval.upper) : "",
+                  e && e->pi_in_regime_range ? (*e->pi_in_regime_range ? "yes" : "no") : "",
+                  any ? "" : refusals, site.reference});
       }
     }
   }
-  if (csv) std::fclose(csv);
+  if (csv) csv->close();
   std::printf("\nc from the inverted law with its %.0f %% interval (fit uncertainty and the site's spread); "
               "Pi = c/(rho_i g H_i); a site is in a regime when its Pi lies in the regime's Pi range\n",
               100.0 * opt.level);

@@ -7,6 +7,7 @@
 #include <set>
 
 #include "engine/error.hpp"
+#include "study/csv_file.hpp"
 #include "study/fits_table.hpp"
 #include "study/store.hpp"
 
@@ -14,17 +15,6 @@ namespace crevasse {
 namespace fs = std::filesystem;
 
 namespace {
-
-// RFC 4180: quote a field holding a comma, quote or line break; double inner quotes.
-std::string csv_field(const std::string& v) {
-  if (v.find_first_of(",\"\r\n") == std::string::npos) return v;
-  std::string out = "\"";
-  for (char c : v) {
-    if (c == '"') out += '"';
-    out += c;
-  }
-  return out + "\"";
-}
 
 std::string json_scalar(const nlohmann::json& v) {
   if (v.is_string()) return v.get<std::string>();
@@ -42,26 +32,6 @@ void flatten(const nlohmann::json& j, const std::string& prefix,
     out[prefix] = json_scalar(j);
   }
 }
-
-class CsvFile {
- public:
-  explicit CsvFile(const fs::path& path) : path_(path), out_(path) {
-    if (!out_) throw InputError("--csv: cannot write " + path.string());
-  }
-  void row(const std::vector<std::string>& fields) {
-    for (std::size_t i = 0; i < fields.size(); ++i) out_ << (i ? "," : "") << csv_field(fields[i]);
-    out_ << "\n";
-  }
-  void close() {
-    out_.close();
-    if (!out_)
-      throw std::runtime_error("--csv: writing " + path_.string() + " failed (disk full?)");
-  }
-
- private:
-  fs::path path_;
-  std::ofstream out_;
-};
 
 void export_table(sqlite3* db, const std::string& table, const fs::path& path) {
   Statement s(db, "SELECT * FROM " + table + " ORDER BY rowid");

@@ -1,12 +1,13 @@
 #include "study/field_observations.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <set>
 
 #include <nlohmann/json.hpp>
 
 #include "engine/error.hpp"
+#include "study/json_checks.hpp"
+#include "study/scene_file.hpp"
 #include "study/study_fit.hpp"
 
 namespace crevasse {
@@ -53,23 +54,26 @@ std::optional<std::pair<double, double>> pair_around(const json& e, const std::s
 }  // namespace
 
 std::vector<FieldObservation> load_field_observations(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open the observations file");
   json doc;
   try {
-    doc = json::parse(in);
-  } catch (const json::parse_error& e) {
+    doc = json::parse(read_input_file(path, "--observations"));
+  } catch (const json::exception& e) {
     throw InputError(path + ": not valid JSON: " + e.what());
   }
   if (!doc.is_object() || !doc.contains("observations") || !doc["observations"].is_array() ||
       doc["observations"].empty())
     throw InputError(path + ": observations: needs a non-empty array of sites");
+  refuse_unknown_keys(doc, path, {"description", "observations", "tensile_strength_literature"});
   std::vector<FieldObservation> out;
   std::set<std::string> ids;
   const json& list = doc["observations"];
   for (std::size_t k = 0; k < list.size(); ++k) {
     const json& e = list[k];
     if (!e.is_object()) throw InputError(where(path, k, "") + " must be an object");
+    refuse_unknown_keys(e, path + ": observations[" + std::to_string(k) + "]",
+                        {"id", "site", "setting", "spacing_median_m", "spacing_statistic",
+                         "spacing_quartiles_m", "spacing_range_m", "spacing_sd_m", "thickness_m",
+                         "thickness_note", "reference", "where_in_reference", "read_at", "notes"});
     FieldObservation o;
     o.id = text(e, "id", where(path, k, "id"), true);
     if (!ids.insert(o.id).second) throw InputError(where(path, k, "id") + ": '" + o.id + "' is repeated");

@@ -23,16 +23,6 @@ std::string num(double v) {
   return buf;
 }
 
-// Text as figure text shows it literally ('_', '^' and '\\' are markup there).
-std::string markup_escaped(const std::string& text) {
-  std::string out;
-  for (char ch : text) {
-    if (ch == '_' || ch == '^' || ch == '\\') out += '\\';
-    out += ch;
-  }
-  return out;
-}
-
 std::string group_value_label(const FitGroup& g, const std::optional<double>& v) {
   if (!v) return std::string(g.symbol) + " n/a";
   if (std::string(g.name) == "thickness") return "H_i = " + num(*v) + " m";
@@ -150,7 +140,7 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
   for (const CaseRecord& c : cases) drawn_cases.emplace_back(&c, "");
   for (std::size_t k = 0; k < added.size(); ++k)
     for (const CaseRecord& c : added[k])
-      drawn_cases.emplace_back(&c, markup_escaped(added_names[k]) + ": ");
+      drawn_cases.emplace_back(&c, analysis::escape_markup(added_names[k]) + ": ");
 
   std::vector<fs::path> written;
   for (Quantity q : kQuantities) {
@@ -163,7 +153,7 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
     // Leave fragmented cases out of the fit when asked, or when the stored fits did.
     fit_opts.exclude_fragmented = opt.exclude_fragmented;
     for (const FitRecord& r : read_fit_records(store, quantity_key(q), group.name))
-      if (r.accounting.find("fragmented (excluded)") != std::string::npos)
+      if (r.accounting.find(kFragmentedExcluded) != std::string::npos)
         fit_opts.exclude_fragmented = true;
     const StudyFit fit = fit_study(cases, q, group, fit_opts);
     std::vector<std::pair<double, analysis::RegimePoint>> keyed;  // colour group value, point
@@ -213,8 +203,8 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
       for (const auto& [reason, k] : missing) n += k;
       return n;
     }();
-    std::string shown = markup_escaped(study_name);
-    for (const std::string& name : added_names) shown += " + " + markup_escaped(name);
+    std::string shown = analysis::escape_markup(study_name);
+    for (const std::string& name : added_names) shown += " + " + analysis::escape_markup(name);
     options.title = shown + ": median " +
                     (q == Quantity::spacing ? std::string("spacing") : std::string("depth")) +
                     ", " + std::to_string(measured) + " of " + std::to_string(points.size()) +
@@ -267,7 +257,7 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
     samples.push_back(std::move(sample));
   }
   analysis::CdfFigureOptions cdf;
-  cdf.title = markup_escaped(study_name) + ": crevasse spacings of " + std::to_string(samples.size()) + " case(s)";
+  cdf.title = analysis::escape_markup(study_name) + ": crevasse spacings of " + std::to_string(samples.size()) + " case(s)";
   cdf.x_label = opt.cdf_normalise == "median"      ? "L_p / median L_p of the case"
                 : opt.cdf_normalise == "thickness" ? "L_p/H_i"
                                                    : "L_p [m]";

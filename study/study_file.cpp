@@ -10,7 +10,7 @@
 
 #include "engine/error.hpp"
 #include "study/case_hash.hpp"
-#include "study/scene_file.hpp"
+#include "study/json_checks.hpp"
 #include "study/scene_file.hpp"
 
 namespace crevasse {
@@ -178,21 +178,6 @@ std::string read_text(const std::filesystem::path& path, const std::string& fiel
   return read_input_file(path, field);
 }
 
-// Every key of `obj` must be one of `allowed`.
-void refuse_unknown(const ordered_json& obj, const std::string& where,
-                    std::initializer_list<const char*> allowed) {
-  for (auto it = obj.begin(); it != obj.end(); ++it) {
-    bool ok = false;
-    for (const char* a : allowed) ok = ok || it.key() == a;
-    if (!ok) {
-      std::string list;
-      for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
-      fail(where.empty() ? it.key() : where + "." + it.key(),
-           "unknown key (allowed: " + list + ")");
-    }
-  }
-}
-
 int integer_in(const ordered_json& v, const std::string& field, int lo, int hi) {
   if (!v.is_number_integer()) fail(field, "must be an integer, got " + v.dump());
   const auto x = v.get<std::int64_t>();
@@ -264,7 +249,7 @@ analysis::MeasureSettings measure_settings_from_json(const json& j) {
   if (j.is_null()) return s;
   if (!j.is_object()) fail("measurement", "must be an object");
   const ordered_json o = j;
-  refuse_unknown(o, "measurement",
+  refuse_unknown_keys(o, "measurement",
                  {"frame", "damage_threshold", "eps_v_p_threshold", "window_min_x_m", "window_max_x_m",
                   "window_margin_over_h", "resolution_floor_over_dx", "link_distance_over_spacing",
                   "surface_reach_over_dx", "surface_smoothing_bins",
@@ -346,7 +331,7 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
     throw InputError(source + ": not valid JSON (" + e.what() + ")");
   }
   if (!doc.is_object()) fail(source, "a study file must be a JSON object");
-  refuse_unknown(doc, "",
+  refuse_unknown_keys(doc, "",
                  {"name", "description", "base_scene", "fixed", "sweep", "replicas", "measurement",
                   "resources"});
 
@@ -412,7 +397,7 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
   if (doc.contains("replicas")) {
     const ordered_json& r = doc.at("replicas");
     if (r.is_object()) {
-      refuse_unknown(r, "replicas", {"count", "first_seed"});
+      refuse_unknown_keys(r, "replicas", {"count", "first_seed"});
       if (r.contains("count")) st.replicas = integer_in(r.at("count"), "replicas.count", 1, 1000);
       if (r.contains("first_seed"))
         st.first_seed = static_cast<std::uint64_t>(
@@ -432,7 +417,7 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
   if (doc.contains("resources")) {
     const ordered_json& r = doc.at("resources");
     if (!r.is_object()) fail("resources", "must be an object");
-    refuse_unknown(r, "resources",
+    refuse_unknown_keys(r, "resources",
                    {"jobs", "threads_per_case", "case_time_limit_s", "checkpoint_interval_s"});
     if (r.contains("checkpoint_interval_s"))
       st.resources.checkpoint_interval_s = number_in(

@@ -68,7 +68,7 @@ StudyFit fit_study(const std::vector<CaseRecord>& cases, Quantity quantity, cons
     if (reason.empty() && (!x || !std::isfinite(*x) || *x <= 0.0))
       reason = std::string("without a positive ") + group.name;
     if (reason.empty() && options.exclude_fragmented && c.fragmented)
-      reason = "fragmented (excluded)";
+      reason = kFragmentedExcluded;
     if (!reason.empty()) {
       ++fit.skipped[reason];
       continue;

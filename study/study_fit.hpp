@@ -18,11 +18,15 @@ namespace crevasse {
 std::string short_number(double v);
 
 
+// The reason a fit gives for a fragmented case it left out; it is in the fits table's
+// `accounting`, which is how `crevasse plot` knows the stored fits left such cases out.
+inline constexpr const char* kFragmentedExcluded = "fragmented (excluded)";
+
 struct StudyFitOptions {
   double level = 0.95;
   // Exponents of the broken line's segments held at a value (below, above Π*); empty = free.
   std::optional<double> fixed_b1, fixed_b2;
-  bool exclude_fragmented = false;  // leave out cases flagged fragmented
+  bool exclude_fragmented = false;  // leave out cases flagged fragmented (kFragmentedExcluded)
 };
 
 struct StudyFit {

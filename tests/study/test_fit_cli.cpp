@@ -426,8 +426,8 @@ TEST(FitCli, CalibrateObservationsFile) {
   // The inside site's c: its interval holds the truth, and the estimate is within 10 % of it
   // (the fitted law's error at Π = 0.3 from 5 % log-normal scatter on 20 cases is ~2 %, which
   // b = 0.5 doubles in c).
-  const auto row_at = csv.find("\"inside\"");
-  ASSERT_NE(row_at, std::string::npos);
+  const auto row_at = csv.find("\ninside,") + 1;
+  ASSERT_NE(row_at, 0u) << csv;
   std::vector<std::string> cells;
   std::string cell;
   bool quoted = false;
@@ -454,6 +454,11 @@ TEST(FitCli, CalibrateObservationsFile) {
   std::ofstream(dir / "bad.json") << bad.dump();
   expect_one_line_error(test::run_cli(dir.path(), "calibrate --db s.db --observations bad.json"),
                         "observations[0].spacing_quartiles_m");
+  bad = file;
+  bad["observations"][0]["spacing_quartile_m"] = {1.0, 2.0};  // a typo is refused, not ignored
+  std::ofstream(dir / "bad.json") << bad.dump();
+  expect_one_line_error(test::run_cli(dir.path(), "calibrate --db s.db --observations bad.json"),
+                        "observations[0].spacing_quartile_m: unknown key");
   expect_one_line_error(
       test::run_cli(dir.path(), "calibrate --db s.db --observations obs.json --spacing 10"),
       "--observations");
