@@ -27,11 +27,23 @@ struct CappedVonMisesParams {
   double residual_friction_m = 0.0;
 };
 
+// The softening factor e^{−ζ ε_v^p} of the cap and of the shear strength. e^{−ζ·0} is exactly 1,
+// so intact ice (most of a glacier) skips the exponential.
+inline double softening_factor(const CappedVonMisesParams& p, double eps_v_p) {
+  return eps_v_p == 0.0 ? 1.0 : std::exp(-p.softening_zeta * eps_v_p);
+}
+
+// Shear strength with the softening factor f = e^{−ζ ε_v^p} of the opening already evaluated.
+inline double shear_strength_softened(const CappedVonMisesParams& p, double f, double pressure) {
+  if (!p.damage_softens_shear) return p.shear_strength_qy;
+  const double intact = p.shear_strength_qy * f;
+  return std::min(p.shear_strength_qy, std::max(intact, p.residual_friction_m * std::max(pressure, 0.0)));
+}
+
 // Shear strength at a given opening: q_y, or q_y·exp(−ζ ε_v^p) when damage softens shear.
 inline double shear_strength(const CappedVonMisesParams& p, double eps_v_p, double pressure) {
   if (!p.damage_softens_shear) return p.shear_strength_qy;
-  const double intact = p.shear_strength_qy * std::exp(-p.softening_zeta * eps_v_p);
-  return std::min(p.shear_strength_qy, std::max(intact, p.residual_friction_m * std::max(pressure, 0.0)));
+  return shear_strength_softened(p, softening_factor(p, eps_v_p), pressure);
 }
 
 template <int Dim>
@@ -44,7 +56,7 @@ struct ReturnResult {
 
 // Tensile cap pressure p_c(ε_v^p) = −c·exp(−ζ ε_v^p).
 inline double cap_pressure(const CappedVonMisesParams& p, double eps_v_p) {
-  return -p.tensile_strength_c * std::exp(-p.softening_zeta * eps_v_p);
+  return -p.tensile_strength_c * softening_factor(p, eps_v_p);
 }
 
 // Solves g(Δ) = p_tr + K Δ + c·exp(−ζ(ε_v + Δ)) = 0 for Δ > 0, given g(0) < 0 (the trial state
@@ -59,8 +71,7 @@ inline double cap_return_increment(double p_trial, double bulk_k, double eps_v_p
                                    const CappedVonMisesParams& p) {
   const double c = p.tensile_strength_c;
   const double zeta = p.softening_zeta;
-  const double pc_now = cap_pressure(p, eps_v_p);
-  if (zeta <= 0.0) return (pc_now - p_trial) / bulk_k;  // perfectly plastic cap: exact
+  if (zeta <= 0.0) return (cap_pressure(p, eps_v_p) - p_trial) / bulk_k;  // perfectly plastic cap: exact
   double lo = 0.0;
   double hi = -p_trial / bulk_k;  // g(hi) = c·exp(..) > 0 because p_trial < 0
   double d = hi;
@@ -77,16 +88,19 @@ inline double cap_return_increment(double p_trial, double bulk_k, double eps_v_p
   return d;
 }
 
+// `softening` is e^{−ζ ε_v^p} at the start of the step (softening_factor): the engine has it
+// from the volume averaging and passes it in, so the exponential is evaluated once per particle.
 template <int Dim>
 inline ReturnResult<Dim> return_map_capped_von_mises(const Vec<Dim>& eps_trial, double eps_v_p,
                                                     const ElasticModuli& m,
-                                                    const CappedVonMisesParams& p) {
+                                                    const CappedVonMisesParams& p,
+                                                    double softening) {
   ReturnResult<Dim> r;
   r.eps = eps_trial;
   const double k = m.bulk(Dim);
   const double tr = eps_trial.sum();
   const double p_trial = -k * tr;
-  if (p_trial < cap_pressure(p, eps_v_p)) {
+  if (p_trial < -p.tensile_strength_c * softening) {
     const double delta = cap_return_increment(p_trial, k, eps_v_p, p);
     r.eps.array() -= delta / Dim;
     r.delta_eps_v = delta;
@@ -95,13 +109,21 @@ inline ReturnResult<Dim> return_map_capped_von_mises(const Vec<Dim>& eps_trial, 
   const double tr_new = r.eps.sum();
   Vec<Dim> dev = r.eps.array() - tr_new / Dim;
   const double q_trial = std::sqrt(6.0) * m.mu * dev.norm();  // q = sqrt(3/2)·2μ‖dev ε‖
-  const double q_y = shear_strength(p, eps_v_p + r.delta_eps_v, -k * tr_new);
+  const double q_y = r.cap_active ? shear_strength(p, eps_v_p + r.delta_eps_v, -k * tr_new)
+                                  : shear_strength_softened(p, softening, -k * tr_new);
   if (q_trial > q_y) {
     dev *= q_y / q_trial;
     r.eps = (dev.array() + tr_new / Dim).matrix();
     r.shear_active = true;
   }
   return r;
+}
+
+template <int Dim>
+inline ReturnResult<Dim> return_map_capped_von_mises(const Vec<Dim>& eps_trial, double eps_v_p,
+                                                    const ElasticModuli& m,
+                                                    const CappedVonMisesParams& p) {
+  return return_map_capped_von_mises<Dim>(eps_trial, eps_v_p, m, p, softening_factor(p, eps_v_p));
 }
 
 }  // namespace crevasse

@@ -2,6 +2,7 @@
 // Particle state as structure of arrays. Hot fields of the step (x, v, C, F_E, τ, mass, V0)
 // are always present; ε_v^p is allocated only when the scene names plasticity, so an elastic
 // scene carries no plastic storage (SPEC §4).
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <numeric>
@@ -43,34 +44,68 @@ struct Particles {
     vol0.push_back(v0);
   }
 
-  // Reorders every array by `order` (order[i] = old index of the new i-th particle).
-  void permute(const std::vector<std::uint32_t>& order) {
-    apply(x, order); apply(v, order); apply(C, order); apply(F_e, order); apply(tau, order);
-    apply(mass, order); apply(vol0, order);
-    if (has_plastic_state()) apply(eps_v_p, order);
-    if (!drive_x0.empty()) apply(drive_x0, order);
-    if (!x_ref.empty()) { apply(x_ref, order); apply(gate_eps, order); }
+  // Capacity of every hot array set to exactly the particle count (after seeding), so that
+  // the in-place reorders below never carry spare capacity into the steps.
+  void shrink_to_fit() {
+    x.shrink_to_fit(); v.shrink_to_fit(); C.shrink_to_fit(); F_e.shrink_to_fit();
+    tau.shrink_to_fit(); mass.shrink_to_fit(); vol0.shrink_to_fit();
   }
 
-  // Keeps the particles with keep[i] true, in order; returns the mass removed.
+  // Reorders every array by `order`, a permutation of 0..size()−1 (order[i] = old index of the
+  // new i-th particle). In place, cycle by cycle: the only extra memory is one bit per
+  // particle, so a sorting step holds no second copy of any array (issue 6: ≤ 200 B/particle
+  // at every step).
+  void permute(const std::vector<std::uint32_t>& order) {
+    std::vector<std::uint64_t> done((order.size() + 63) / 64);
+    const auto apply = [&](auto& a) { permute_in_place(a, order, done); };
+    apply(x); apply(v); apply(C); apply(F_e); apply(tau); apply(mass); apply(vol0);
+    if (has_plastic_state()) apply(eps_v_p);
+    if (!drive_x0.empty()) apply(drive_x0);
+    if (!x_ref.empty()) { apply(x_ref); apply(gate_eps); }
+  }
+
+  // Keeps the particles with keep[i] true, in order (in place); returns the mass removed.
   double compact(const std::vector<char>& keep) {
-    std::vector<std::uint32_t> order;
-    order.reserve(size());
     double removed = 0.0;
-    for (std::size_t i = 0; i < size(); ++i) {
-      if (keep[i]) order.push_back(static_cast<std::uint32_t>(i));
-      else removed += mass[i];
-    }
-    permute(order);
+    for (std::size_t i = 0; i < size(); ++i)
+      if (!keep[i]) removed += mass[i];
+    const auto apply = [&](auto& a) { compact_in_place(a, keep); };
+    apply(x); apply(v); apply(C); apply(F_e); apply(tau); apply(mass); apply(vol0);
+    if (has_plastic_state()) apply(eps_v_p);
+    if (!drive_x0.empty()) apply(drive_x0);
+    if (!x_ref.empty()) { apply(x_ref); apply(gate_eps); }
     return removed;
   }
 
  private:
+  // a_new[i] = a_old[order[i]], following each cycle of the permutation once.
   template <class T>
-  static void apply(std::vector<T>& a, const std::vector<std::uint32_t>& order) {
-    std::vector<T> out(order.size());
-    for (std::size_t i = 0; i < order.size(); ++i) out[i] = a[order[i]];
-    a.swap(out);
+  static void permute_in_place(std::vector<T>& a, const std::vector<std::uint32_t>& order,
+                               std::vector<std::uint64_t>& done) {
+    std::fill(done.begin(), done.end(), 0);
+    const auto seen = [&](std::size_t i) { return (done[i >> 6] >> (i & 63)) & 1u; };
+    for (std::size_t start = 0; start < order.size(); ++start) {
+      if (seen(start)) continue;
+      T first = a[start];
+      std::size_t i = start;
+      for (;;) {
+        done[i >> 6] |= std::uint64_t{1} << (i & 63);
+        const std::size_t j = order[i];
+        if (j == start) {
+          a[i] = first;
+          break;
+        }
+        a[i] = a[j];
+        i = j;
+      }
+    }
+  }
+  template <class T>
+  static void compact_in_place(std::vector<T>& a, const std::vector<char>& keep) {
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < a.size(); ++i)
+      if (keep[i]) a[k++] = a[i];
+    a.resize(k);
   }
 };
 

@@ -118,8 +118,8 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   }
   const bool plastic = scene_.has(Effect::plasticity);
   if (scene_.volumetric_averaging) {
-    add_stage("g2p_velocity", [this] { gather_all_velocities(); });
-    add_stage("volume_averaging", [this] { average_volume_change(); });
+    add_stage("g2p_velocity", [this] { gather_velocities_and_scatter_volume(); });
+    add_stage("volume_averaging", [this] { normalise_volume_average(); });
     if (plastic) {
       add_stage("g2p_return_mapping", [this] {
         if (settling_) update_all_particles<false>();
@@ -140,9 +140,7 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
     add_stage("bed_projection", [this] { project_particles_out_of_bed(); });
   if (scene_.has(Effect::drive)) add_stage("drive", [this] { drive_back_layer(); });
   // Particles never leave the domain: the last line of defence, whatever the effects.
-  add_stage("domain_clamp", [this] {
-    for (int a = 0; a < Dim; ++a) clamp_particles(a, domain_lo_[a], domain_hi_[a]);
-  });
+  add_stage("domain_clamp", [this] { clamp_particles(domain_lo_, domain_hi_); });
   if (scene_.records_gate()) add_stage("gate", [this] { record_gate(); });
   if (scene_.has(Effect::outflow)) add_stage("outflow", [this] { remove_outflow(); });
   add_stage("time_step", [this] { update_time_step(); });
@@ -190,13 +188,14 @@ double Simulation<Dim>::bed_phi(const Vec<Dim>& x, Vec<Dim>* normal) const {
                             static_cast<std::size_t>(i) * bed_nk_ + k + 1,
                             static_cast<std::size_t>(i + 1) * bed_nk_ + k,
                             static_cast<std::size_t>(i + 1) * bed_nk_ + k + 1};
-  double phi = 0.0, nx = 0.0, nz = 0.0;
-  for (int c = 0; c < 4; ++c) {
-    phi += w[c] * bed_phi_[f[c]];
-    nx += w[c] * bed_normal_[f[c]][0];
-    nz += w[c] * bed_normal_[f[c]][1];
-  }
+  double phi = 0.0;
+  for (int c = 0; c < 4; ++c) phi += w[c] * bed_phi_[f[c]];
   if (normal) {
+    double nx = 0.0, nz = 0.0;
+    for (int c = 0; c < 4; ++c) {
+      nx += w[c] * bed_normal_[f[c]][0];
+      nz += w[c] * bed_normal_[f[c]][1];
+    }
     normal->setZero();
     const double len = std::hypot(nx, nz);
     (*normal)[0] = len > 0 ? nx / len : 0.0;
@@ -284,6 +283,7 @@ void Simulation<Dim>::seed_particles() {
     }
     particles_.push_back(pos, rho * cell_volume, vol0, fe, tau);
   }
+  particles_.shrink_to_fit();
   if (scene_.has(Effect::plasticity)) particles_.eps_v_p.assign(particles_.size(), 0.0);
   if (scene_.has(Effect::drive)) {
     particles_.drive_x0.assign(particles_.size(), std::numeric_limits<double>::quiet_NaN());
@@ -335,19 +335,23 @@ void Simulation<Dim>::prepare_grid() {
   }
   const double inv_dx = 1.0 / scene_.dx;
   if (steps_ % kSortInterval == 0) {
-    // Sort by cell (x slowest) for locality in P2G/G2P.
-    std::vector<std::uint64_t> key(n);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), [&](const auto& r) {
-      for (std::size_t p = r.begin(); p != r.end(); ++p) {
-        std::uint64_t k = 0;
-        for (int a = 0; a < Dim; ++a)
-          k = (k << 20) | static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(P.x[p][a] * inv_dx)) + (1 << 19));
-        key[p] = k;
-      }
-    });
+    // Sort by cell (x slowest) for locality in P2G/G2P. The keys are released before the
+    // arrays are reordered (in place), so the step's peak memory is the steady state plus the
+    // order and the sort's buffer.
     std::vector<std::uint32_t> order(n);
-    std::iota(order.begin(), order.end(), 0u);
-    std::stable_sort(order.begin(), order.end(), [&](auto a, auto b) { return key[a] < key[b]; });
+    {
+      std::vector<std::uint64_t> key(n);
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), [&](const auto& r) {
+        for (std::size_t p = r.begin(); p != r.end(); ++p) {
+          std::uint64_t k = 0;
+          for (int a = 0; a < Dim; ++a)
+            k = (k << 20) | static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(P.x[p][a] * inv_dx)) + (1 << 19));
+          key[p] = k;
+        }
+      });
+      std::iota(order.begin(), order.end(), 0u);
+      std::stable_sort(order.begin(), order.end(), [&](auto a, auto b) { return key[a] < key[b]; });
+    }
     P.permute(order);
   }
   // Node box covering every particle's stencil.
@@ -370,20 +374,43 @@ void Simulation<Dim>::prepare_grid() {
       });
   grid_.reset(box.first, (box.second - box.first).array() + 1);
 
-  // Counting sort of particle indices into x-slabs (stable: fixed summation order, so P2G is
-  // deterministic whatever the thread count).
-  const int slabs = (grid_.n[0] + kSlabCells - 1) / kSlabCells;
-  slab_start_.assign(static_cast<std::size_t>(slabs) + 1, 0);
-  std::vector<std::uint32_t> slab_of(n);
-  for (std::size_t p = 0; p < n; ++p) {
-    const int b = static_cast<int>(std::floor(P.x[p][0] * inv_dx - 0.5)) - grid_.lo[0];
-    slab_of[p] = static_cast<std::uint32_t>(b / kSlabCells);
-    ++slab_start_[slab_of[p] + 1];
+  // Counting sort of particle indices into x-slabs, stable: within a slab the particles keep
+  // their index order, so P2G sums in a fixed order and is deterministic whatever the thread
+  // count. Parallel over a fixed number of index blocks (not one per thread, so the result
+  // never depends on the thread count): each block counts its particles per slab, a prefix
+  // over (slab, block) gives each block its place in every slab, and each block then fills
+  // its places in index order, which is exactly the serial stable order.
+  const std::size_t slabs = static_cast<std::size_t>((grid_.n[0] + kSlabCells - 1) / kSlabCells);
+  const std::size_t blocks = std::min<std::size_t>(64, (n + kGrain - 1) / kGrain);
+  const std::size_t block_size = (n + blocks - 1) / blocks;
+  const int lo_x = grid_.lo[0];
+  const auto slab_of = [&](std::size_t p) {
+    const int b = static_cast<int>(std::floor(P.x[p][0] * inv_dx - 0.5)) - lo_x;
+    return static_cast<std::size_t>(b / kSlabCells);
+  };
+  auto& offsets = slab_block_offsets_;  // [block][slab]
+  offsets.assign(blocks * slabs, 0);
+  tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t k) {
+    std::uint32_t* count = offsets.data() + k * slabs;
+    for (std::size_t p = k * block_size, e = std::min(n, p + block_size); p < e; ++p) ++count[slab_of(p)];
+  });
+  slab_start_.assign(slabs + 1, 0);
+  std::uint32_t at = 0;
+  for (std::size_t s = 0; s < slabs; ++s) {
+    slab_start_[s] = at;
+    for (std::size_t k = 0; k < blocks; ++k) {
+      const std::uint32_t c = offsets[k * slabs + s];
+      offsets[k * slabs + s] = at;
+      at += c;
+    }
   }
-  for (int s = 0; s < slabs; ++s) slab_start_[s + 1] += slab_start_[s];
+  slab_start_[slabs] = at;
   slab_order_.resize(n);
-  std::vector<std::uint32_t> fill(slab_start_.begin(), slab_start_.end() - 1);
-  for (std::size_t p = 0; p < n; ++p) slab_order_[fill[slab_of[p]]++] = static_cast<std::uint32_t>(p);
+  tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t k) {
+    std::uint32_t* place = offsets.data() + k * slabs;
+    for (std::size_t p = k * block_size, e = std::min(n, p + block_size); p < e; ++p)
+      slab_order_[place[slab_of(p)]++] = static_cast<std::uint32_t>(p);
+  });
 }
 
 template <int Dim>
@@ -540,29 +567,38 @@ void Simulation<Dim>::apply_velocity_boxes_to_grid() {
 }
 
 template <int Dim>
-void Simulation<Dim>::gather_velocity(std::size_t p) {
-  // APIC/MLS gather of the particle velocity and its affine matrix C from the grid.
+void Simulation<Dim>::gather_velocity(std::size_t p, const StencilWeights<Dim>& w, const Vec<Dim>& xg) {
+  // APIC/MLS gather of the particle velocity and its affine matrix C from the grid, with the
+  // stencil weights w of the particle at grid coordinate xg = x/dx. Accumulated in scalars:
+  // Eigen's outer product of small vectors went through stack temporaries and stalled on
+  // store-to-load forwarding (docs/performance.md, 3D); the products and sums are the same
+  // ones, in the same order: v_i += w·v_node,i and B_ij += (w·v_node,i)·Δx_j.
   auto& P = particles_;
   const double dx = scene_.dx, inv_dx = 1.0 / dx;
-  const Vec<Dim> xg = P.x[p] * inv_dx;
-  const StencilWeights<Dim> w(xg);
   const IVec<Dim> base = w.base();
-  Vec<Dim> v = Vec<Dim>::Zero();
-  Mat<Dim> b = Mat<Dim>::Zero();
+  double v[Dim] = {};
+  double b[Dim][Dim] = {};
   for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
     const IVec<Dim> node = base + off;
-    const Vec<Dim> dpos = (node.template cast<double>() - xg) * dx;
+    double dpos[Dim];
+    for (int j = 0; j < Dim; ++j) dpos[j] = (static_cast<double>(node[j]) - xg[j]) * dx;
     const Vec<Dim>& vi = grid_.vel[grid_.flat(node)];
-    v += wt * vi;
-    b += wt * vi * dpos.transpose();
+    for (int i = 0; i < Dim; ++i) {
+      const double wv = wt * vi[i];
+      v[i] += wv;
+      for (int j = 0; j < Dim; ++j) b[i][j] += wv * dpos[j];
+    }
   });
-  P.v[p] = v;
-  P.C[p] = (4.0 * inv_dx * inv_dx) * b;
+  const double scale = 4.0 * inv_dx * inv_dx;
+  for (int i = 0; i < Dim; ++i) {
+    P.v[p][i] = v[i];
+    for (int j = 0; j < Dim; ++j) P.C[p](i, j) = scale * b[i][j];
+  }
 }
 
 template <int Dim>
 template <bool Plastic>
-void Simulation<Dim>::update_particle(std::size_t p, double volume_scale) {
+void Simulation<Dim>::update_particle(std::size_t p, double volume_scale, double softening) {
   // Move, update F_E ← ΔF·F_E (ΔF optionally rescaled to the averaged volume change), then
   // the stress, through the return mapping when the scene is plastic.
   auto& P = particles_;
@@ -572,7 +608,7 @@ void Simulation<Dim>::update_particle(std::size_t p, double volume_scale) {
   Mat<Dim> fe = df * P.F_e[p];
   PrincipalStretch<Dim> s = principal_hencky<Dim>(fe);
   if constexpr (Plastic) {
-    const ReturnResult<Dim> ret = return_map_capped_von_mises<Dim>(s.eps, P.eps_v_p[p], moduli_, plastic_);
+    const ReturnResult<Dim> ret = return_map_capped_von_mises<Dim>(s.eps, P.eps_v_p[p], moduli_, plastic_, softening);
     if (ret.cap_active || ret.shear_active) {
       // F_E = U exp(ε') Uᵀ R: rescale the left stretch in its principal frame.
       const Vec<Dim> scale = (ret.eps - s.eps).array().exp();
@@ -590,46 +626,49 @@ template <bool Plastic>
 void Simulation<Dim>::grid_to_particle() {
   auto& P = particles_;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, P.size(), kGrain), [&](const auto& r) {
+    const double inv_dx = 1.0 / scene_.dx;
     for (std::size_t p = r.begin(); p != r.end(); ++p) {
-      gather_velocity(p);
-      update_particle<Plastic>(p, 1.0);
+      const Vec<Dim> xg = P.x[p] * inv_dx;
+      gather_velocity(p, StencilWeights<Dim>(xg), xg);
+      update_particle<Plastic>(p, 1.0, Plastic ? softening_factor(plastic_, P.eps_v_p[p]) : 1.0);
     }
   });
   finish_step<Plastic>();
 }
 
+// ΔJ-bar (cf. the F-bar family, e.g. Coombs et al. 2018, CMAME 333:1–21): the step's volume
+// ratio ΔJ_p = det(I + Δt C_p) is mass-averaged onto the grid nodes with the same quadratic
+// weights as P2G and interpolated back; each particle then takes the averaged ΔJ̄_p and keeps
+// its own isochoric part. A field that varies linearly over the stencil is reproduced, so a
+// smooth deformation is unchanged; a particle-to-particle checkerboard is removed.
+// Only intact ice is averaged: each particle enters with weight (1 − D) (D the damage,
+// 1 − e^{−ζ ε_v^p}) and takes ΔJ_used = (1 − D)·ΔJ̄ + D·ΔJ_p. An opening crack then keeps its
+// volume change to itself instead of handing part of it to the intact ice around it, which
+// would widen every crack by a cell each time it opens further.
+// Three passes, fused with G2P (issue 6): (1) one coloured sweep gathers v and C and scatters
+// (1 − D) m ΔJ and (1 − D) m with the same weights; (2) per node, the average; (3) the update
+// sweep interpolates ΔJ̄ back, recomputing ΔJ_p from C (unchanged since (1)). 1 − D = e^{−ζ ε_v^p}
+// is kept per particle from (1) to (3), where the return mapping uses it as its softening factor
+// too: one exponential per particle and step instead of four.
 template <int Dim>
-void Simulation<Dim>::gather_all_velocities() {
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, particles_.size(), kGrain), [&](const auto& r) {
-    for (std::size_t p = r.begin(); p != r.end(); ++p) gather_velocity(p);
-  });
-}
-
-template <int Dim>
-void Simulation<Dim>::average_volume_change() {
-  // ΔJ-bar (cf. the F-bar family, e.g. Coombs et al. 2018, CMAME 333:1–21): the step's volume
-  // ratio ΔJ_p = det(I + Δt C_p) is mass-averaged onto the grid nodes with the same quadratic
-  // weights as P2G and interpolated back; each particle then takes the averaged ΔJ̄_p and keeps
-  // its own isochoric part. A field that varies linearly over the stencil is reproduced, so a
-  // smooth deformation is unchanged; a particle-to-particle checkerboard is removed.
-  // Only intact ice is averaged: each particle enters with weight (1 − D) (D the damage,
-  // 1 − e^{−ζ ε_v^p}) and takes ΔJ_used = (1 − D)·ΔJ̄ + D·ΔJ_p. An opening crack then keeps its
-  // volume change to itself instead of handing part of it to the intact ice around it, which
-  // would widen every crack by a cell each time it opens further.
+void Simulation<Dim>::gather_velocities_and_scatter_volume() {
   auto& P = particles_;
   const double inv_dx = 1.0 / scene_.dx;
-  const std::size_t n = P.size();
-  const bool damage = !P.eps_v_p.empty() && plastic_.softening_zeta > 0.0 && !settling_;
-  const double zeta = plastic_.softening_zeta;
-  volume_scale_.resize(n);
+  volume_damage_ = !P.eps_v_p.empty() && plastic_.softening_zeta > 0.0 && !settling_;
+  const bool damage = volume_damage_;
   grid_aux_.assign(2 * grid_.node_count(), 0.0);  // interleaved (Σ w m (1−D) ΔJ, Σ w m (1−D))
-  intact_.resize(n);
+  const bool plastic = !P.eps_v_p.empty();
+  intact_.resize(plastic ? P.size() : 0);
   for_each_particle_coloured([&](std::uint32_t p) {
+    const Vec<Dim> xg = P.x[p] * inv_dx;
+    const StencilWeights<Dim> w(xg);
+    gather_velocity(p, w, xg);
     const double dj = (Mat<Dim>::Identity() + dt_ * P.C[p]).determinant();
-    volume_scale_[p] = dj;
-    intact_[p] = damage ? std::exp(-zeta * P.eps_v_p[p]) : 1.0;
-    const double wm = P.mass[p] * intact_[p];
-    const StencilWeights<Dim> w(P.x[p] * inv_dx);
+    // Without softening (ζ = 0) or while settling the weight is 1; then e^{−ζ ε} is 1 as well,
+    // or no return mapping runs.
+    const double intact = damage ? softening_factor(plastic_, P.eps_v_p[p]) : 1.0;
+    if (plastic) intact_[p] = intact;
+    const double wm = P.mass[p] * intact;
     const IVec<Dim> base = w.base();
     for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
       const std::size_t f = 2 * grid_.flat(base + off);
@@ -637,6 +676,10 @@ void Simulation<Dim>::average_volume_change() {
       grid_aux_[f + 1] += wt * wm;
     });
   });
+}
+
+template <int Dim>
+void Simulation<Dim>::normalise_volume_average() {
   // Per node, once: the averaged ΔJ and whether the node carries one (nodes reached only by
   // (nearly) broken ice do not).
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid_.node_count(), kGrain), [&](const auto& r) {
@@ -646,28 +689,37 @@ void Simulation<Dim>::average_volume_change() {
       grid_aux_[2 * f + 1] = has ? 1.0 : 0.0;
     }
   });
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), [&](const auto& r) {
-    for (std::size_t p = r.begin(); p != r.end(); ++p) {
-      const StencilWeights<Dim> w(P.x[p] * inv_dx);
-      const IVec<Dim> base = w.base();
-      double jbar = 0.0, wsum = 0.0;
-      for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
-        const std::size_t f = 2 * grid_.flat(base + off);
-        jbar += wt * grid_aux_[f];
-        wsum += wt * grid_aux_[f + 1];
-      });
-      const double dj = volume_scale_[p];
-      const double used = wsum > 0.0 ? intact_[p] * (jbar / wsum) + (1.0 - intact_[p]) * dj : dj;
-      volume_scale_[p] = (dj > 0.0 && used > 0.0) ? used / dj : 1.0;
-    }
+}
+
+template <int Dim>
+double Simulation<Dim>::averaged_volume_scale(std::size_t p, const StencilWeights<Dim>& w,
+                                              double intact) const {
+  // ΔJ_used/ΔJ_p of particle p (before its update moves it), from the normalised grid_aux_.
+  const auto& P = particles_;
+  const IVec<Dim> base = w.base();
+  double jbar = 0.0, wsum = 0.0;
+  for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
+    const std::size_t f = 2 * grid_.flat(base + off);
+    jbar += wt * grid_aux_[f];
+    wsum += wt * grid_aux_[f + 1];
   });
+  const double dj = (Mat<Dim>::Identity() + dt_ * P.C[p]).determinant();
+  const double used = wsum > 0.0 ? intact * (jbar / wsum) + (1.0 - intact) * dj : dj;
+  return (dj > 0.0 && used > 0.0) ? used / dj : 1.0;
 }
 
 template <int Dim>
 template <bool Plastic>
 void Simulation<Dim>::update_all_particles() {
+  const double inv_dx = 1.0 / scene_.dx;
+  const bool damage = volume_damage_;
+  const bool stored = !intact_.empty();
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, particles_.size(), kGrain), [&](const auto& r) {
-    for (std::size_t p = r.begin(); p != r.end(); ++p) update_particle<Plastic>(p, volume_scale_[p]);
+    for (std::size_t p = r.begin(); p != r.end(); ++p) {
+      const StencilWeights<Dim> w(Vec<Dim>(particles_.x[p] * inv_dx));
+      const double intact = stored ? intact_[p] : 1.0;
+      update_particle<Plastic>(p, averaged_volume_scale(p, w, damage ? intact : 1.0), intact);
+    }
   });
   finish_step<Plastic>();
 }
@@ -686,18 +738,23 @@ void Simulation<Dim>::project_particles_out_of_bed() {
   auto& P = particles_;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, P.size(), kGrain), [&](const auto& r) {
     for (std::size_t p = r.begin(); p != r.end(); ++p) {
+      // The normal (two more interpolations and a hypot) only for the few particles inside.
+      const double phi = bed_phi(P.x[p], nullptr);
+      if (phi >= 0.0) continue;
       Vec<Dim> n;
-      const double phi = bed_phi(P.x[p], &n);
-      if (phi < 0.0) P.x[p] -= phi * n;
+      bed_phi(P.x[p], &n);
+      P.x[p] -= phi * n;
     }
   });
 }
 
 template <int Dim>
-void Simulation<Dim>::clamp_particles(int axis, double lo, double hi) {
+void Simulation<Dim>::clamp_particles(const Vec<Dim>& lo, const Vec<Dim>& hi) {
+  // Every axis in one sweep (the clamps of different axes are independent).
   auto& P = particles_;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, P.size(), kGrain), [&](const auto& r) {
-    for (std::size_t p = r.begin(); p != r.end(); ++p) P.x[p][axis] = std::clamp(P.x[p][axis], lo, hi);
+    for (std::size_t p = r.begin(); p != r.end(); ++p)
+      for (int a = 0; a < Dim; ++a) P.x[p][a] = std::clamp(P.x[p][a], lo[a], hi[a]);
   });
 }
 
@@ -706,13 +763,17 @@ void Simulation<Dim>::remove_outflow() {
   // Ice within three cells of the downstream end has left the scene (SPEC §2).
   const double x_out = domain_hi_[0] - 3.0 * scene_.dx;
   auto& P = particles_;
-  bool any = false;
-  std::vector<char> keep(P.size());
-  for (std::size_t p = 0; p < P.size(); ++p) {
-    keep[p] = P.x[p][0] < x_out;
-    any |= !keep[p];
-  }
+  // Most steps remove nothing: look first (in parallel), allocate the mask only when needed.
+  const bool any = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, P.size(), kGrain), false,
+      [&](const auto& r, bool found) {
+        for (std::size_t p = r.begin(); p != r.end() && !found; ++p) found = !(P.x[p][0] < x_out);
+        return found;
+      },
+      [](bool a, bool b) { return a || b; });
   if (!any) return;
+  std::vector<char> keep(P.size());
+  for (std::size_t p = 0; p < P.size(); ++p) keep[p] = P.x[p][0] < x_out;
   if (records_gate()) {
     for (std::size_t p = 0; p < P.size(); ++p) {
       if (keep[p] || P.gate_eps[p] < 0.0f) continue;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "engine/bed.hpp"
+#include "engine/bspline.hpp"
 #include "engine/capped_von_mises.hpp"
 #include "engine/grid.hpp"
 #include "engine/hencky.hpp"
@@ -101,17 +102,21 @@ class Simulation {
   void apply_velocity_boxes_to_grid();
   template <bool Plastic>
   void grid_to_particle();  // gather + update fused (no volume averaging)
-  void gather_velocity(std::size_t p);
+  void gather_velocity(std::size_t p, const StencilWeights<Dim>& w, const Vec<Dim>& xg);
   template <bool Plastic>
-  void update_particle(std::size_t p, double volume_scale);
-  void gather_all_velocities();
-  void average_volume_change();
+  void update_particle(std::size_t p, double volume_scale, double softening);  // softening: e^{−ζ ε_v^p}
+  // ΔJ-bar volume averaging, fused into the G2P sweeps (average_volume_change() explains it):
+  // gather v, C and scatter the weighted ΔJ in one coloured sweep; normalise per node; the
+  // update sweep interpolates ΔJ̄ back and updates the particle at once.
+  void gather_velocities_and_scatter_volume();
+  void normalise_volume_average();
+  double averaged_volume_scale(std::size_t p, const StencilWeights<Dim>& w, double intact) const;
   template <bool Plastic>
   void update_all_particles();
   template <bool Plastic>
   void finish_step();
   void project_particles_out_of_bed();
-  void clamp_particles(int axis, double lo, double hi);
+  void clamp_particles(const Vec<Dim>& lo, const Vec<Dim>& hi);
   void remove_outflow();
   void init_gate();
   void record_gate();
@@ -132,13 +137,16 @@ class Simulation {
 
   std::vector<Stage> stage_fns_;
   std::vector<StageStats> stages_;
-  // P2G colouring: particle indices grouped by x-slab of kSlabCells cells.
+  // P2G colouring: particle indices grouped by x-slab of kSlabCells cells, and the per-block
+  // slab counts of the parallel counting sort that builds it (reused every step).
   std::vector<std::uint32_t> slab_order_;
   std::vector<std::uint32_t> slab_start_;
-  // Volume averaging scratch (reused every step): per-particle ΔJ̄/ΔJ, per-node averaged ΔJ.
-  std::vector<double> volume_scale_;
-  std::vector<double> intact_;  // e^{−ζ ε_v^p}, computed once per step for the averaging
+  std::vector<std::uint32_t> slab_block_offsets_;
+  // Volume averaging scratch (reused every step): per node (Σ w m (1−D) ΔJ, Σ w m (1−D)), then
+  // (averaged ΔJ, whether the node carries one).
   std::vector<double> grid_aux_;
+  std::vector<double> intact_;  // per particle e^{−ζ ε_v^p} (plastic scenes), from G2P to the update
+  bool volume_damage_ = false;  // this step's averaging weights particles by 1 − D
   std::vector<double> drive_node_mass_;  // per node: mass from the driven layer (drive_grid)
 
   Vec<Dim> domain_lo_, domain_hi_;
