@@ -5,12 +5,17 @@
 //    particle-step of each named stage of the step (Simulation::stages());
 //  * particle_B / grid_B: bytes per particle of the per-particle arrays of Particles<Dim>
 //    (capacity × element size) and of the background grid (mass + velocity per node);
+//  * sortstep/…: sort_step_peak_heap_B, the peak heap per particle during step 100 (a later
+//    sorting step, arrays at their steady size), against heap_B just before it;
 //  * heap_B / peak_heap_B / first_step_peak_heap_B: live heap held by the simulation after the
 //    measured steps, its peak during them, and its peak during the first step (which sorts
 //    the particles), per particle (everything: particles, grid, scratch, bed table);
 //  * allocs_per_step / alloc_B_per_step: operator new calls and bytes during the measured
 //    steps, per step. This program replaces the global operator new to count them.
 #include <benchmark/benchmark.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
 #include <malloc.h>
 #include <tbb/global_control.h>
 
@@ -165,7 +170,44 @@ void step_benchmark(benchmark::State& state, Material material, int threads) {
   }
 }
 
+// Peak heap of a later sorting step (step 100: the particles are re-sorted every 100 steps),
+// once the arrays have their steady size: the steady heap plus the sort's own temporaries.
+template <int Dim>
+void sort_step_benchmark(benchmark::State& state, const SceneConfig& scene) {
+  const std::int64_t heap_before = g_live_bytes.load();
+  Simulation<Dim> sim(scene);
+  for (auto _ : state) {
+    while (sim.steps() < 100) sim.step();  // steps 0..99; step 100 sorts again
+    g_peak_bytes.store(g_live_bytes.load());
+    const double steady = static_cast<double>(g_live_bytes.load() - heap_before);
+    sim.step();
+    const double n = static_cast<double>(sim.particles().size());
+    state.counters["heap_B"] = steady / n;
+    state.counters["sort_step_peak_heap_B"] = static_cast<double>(g_peak_bytes.load() - heap_before) / n;
+  }
+}
+
+// The shipped H_i = 300 m glacier (18,000 particles), which also carries the gate records and
+// the piston marker, and whose grid box includes the air above the step.
+SceneConfig glacier_scene() {
+  std::ifstream f(std::string(CREVASSE_SOURCE_DIR) + "/studies/scenes/glacier_2d_H300.json");
+  nlohmann::json j = nlohmann::json::parse(f);
+  j["output"]["vtu_interval"] = 0.0;
+  j["output"]["png"] = false;
+  return scene_from_json(j);
+}
+
 void register_all() {
+  for (int dim : {2, 3}) {
+    const std::string name = "sortstep/" + std::to_string(dim) + "d/softening";
+    auto* b = dim == 2 ? benchmark::RegisterBenchmark(name.c_str(), sort_step_benchmark<2>,
+                                                      block_scene(2, Material::softening))
+                       : benchmark::RegisterBenchmark(name.c_str(), sort_step_benchmark<3>,
+                                                      block_scene(3, Material::softening));
+    b->Iterations(1)->Repetitions(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+  }
+  benchmark::RegisterBenchmark("sortstep/2d/glacier_H300", sort_step_benchmark<2>, glacier_scene())
+      ->Iterations(1)->Repetitions(1)->UseRealTime()->Unit(benchmark::kMillisecond);
   for (int dim : {2, 3}) {
     for (Material m : {Material::elastic, Material::softening}) {
       for (int threads : {1, 2}) {

@@ -27,6 +27,10 @@ def load(path):
         data = json.load(f)
     runs = {}
     for b in data["benchmarks"]:
+        if b["run_name"].startswith("sortstep/"):
+            # One repetition only (no aggregates): keep the single run as its "median".
+            runs.setdefault(b["run_name"].split("/iterations:")[0], {})["median"] = b
+            continue
         if b.get("run_type") != "aggregate":
             continue
         name = b["run_name"].split("/iterations:")[0]
@@ -62,8 +66,12 @@ def main(argv):
     _, limit_runs = load(argv[2])
     show_stages = "--stages" in argv
     rows = {}
+    sort_steps = {}
     for runs in (step_runs, limit_runs):
         for name, aggs in runs.items():
+            if name.startswith("sortstep/"):
+                sort_steps[name] = aggs["median"]
+                continue
             rows[key_of(name)] = aggs
     rate = {k: a["median"]["particle_steps_per_s"] for k, a in rows.items()}
     # One thread: particles per CPU-second of the benchmark thread, which a loaded machine
@@ -122,6 +130,11 @@ def main(argv):
                      f"{med['allocs_per_step']:.1f}"] + \
                     [f"{ph[p]:.0f}" for p in ["prepare", "p2g", "grid", "g2p", "other"]]
         print("| " + " | ".join(cells) + " |")
+    for name, med in sorted(sort_steps.items()):
+        dim, what = name.split("/")[1].upper(), name.split("/")[2].replace("_", " ")
+        print()
+        print(f"{dim} {what}, a later sorting step (step 100): heap {med['heap_B']:.0f} B/particle "
+              f"before it, peak {med['sort_step_peak_heap_B']:.0f} B/particle during it.")
     print()
     print("M pst/s: million particle-steps per second (wall clock), median; ±: its standard "
           "deviation over the repetitions. of limit: fraction of the limit kernel at the same "
