@@ -105,7 +105,7 @@ class Simulation {
   void gather_velocity(std::size_t p, const StencilWeights<Dim>& w, const Vec<Dim>& xg);
   template <bool Plastic>
   void update_particle(std::size_t p, double volume_scale, double softening);  // softening: e^{−ζ ε_v^p}
-  // ΔJ-bar volume averaging, fused into the G2P sweeps (average_volume_change() explains it):
+  // ΔJ-bar volume averaging, fused into the G2P sweeps (explained above gather_velocities_and_scatter_volume in simulation.cpp):
   // gather v, C and scatter the weighted ΔJ in one coloured sweep; normalise per node; the
   // update sweep interpolates ΔJ̄ back and updates the particle at once.
   void gather_velocities_and_scatter_volume();
