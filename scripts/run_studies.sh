@@ -10,7 +10,7 @@
 # Measured cost on the 2-core development VM, in case wall time (docs/study_format.md,
 # "Shipped studies"): spacing_vs_cohesion 36 min, spacing_replicas 9 min,
 # spacing_resolution 23 min, slope 5 min, step_length 6 min, three_d 31 min (3 cases),
-# two_d_long 3 min, three_d_long about 2 h (2 cases; not run yet),
+# two_d_long 3 min, three_d_long 38 min (2 cases, 19 min each side by side),
 # accuracy_cost 28 min (one case at a time, so that each case's wall time and peak memory
 # are its own).
 set -euo pipefail
