@@ -162,7 +162,16 @@ void Simulation<Dim>::build_bed_table() {
   bed_i0_ = static_cast<int>(std::floor(domain_lo_[x_axis] / dx)) - 3;
   bed_k0_ = static_cast<int>(std::floor(domain_lo_[z_axis] / dx)) - 3;
   bed_ni_ = static_cast<int>(std::ceil(domain_hi_[x_axis] / dx)) + 4 - bed_i0_;
-  bed_nk_ = static_cast<int>(std::ceil(domain_hi_[z_axis] / dx)) + 4 - bed_k0_;
+  // Rows up to 4 cells above the highest point of the bed, not up to the top of the domain:
+  // above that row the signed distance is at least 4·dx, so no node there touches the bed
+  // (friction skips nodes outside the table) and the clamped interpolation for a particle
+  // above it stays positive (no projection), exactly as with the full table. For a glacier the
+  // full table was the largest per-domain array (≈ 60 B per particle at H_i = 300 m).
+  double bed_top = -std::numeric_limits<double>::infinity();
+  for (const auto& v : bed_->vertices()) bed_top = std::max(bed_top, v[1]);
+  const int full_nk = static_cast<int>(std::ceil(domain_hi_[z_axis] / dx)) + 4 - bed_k0_;
+  const int bed_nk = static_cast<int>(std::ceil(bed_top / dx)) + 5 - bed_k0_;
+  bed_nk_ = std::max(2, std::min(full_nk, bed_nk));
   bed_phi_.resize(static_cast<std::size_t>(bed_ni_) * bed_nk_);
   bed_normal_.resize(bed_phi_.size());
   tbb::parallel_for(0, bed_ni_, [&](int i) {
