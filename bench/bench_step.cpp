@@ -13,9 +13,6 @@
 //  * allocs_per_step / alloc_B_per_step: operator new calls and bytes during the measured
 //    steps, per step. This program replaces the global operator new to count them.
 #include <benchmark/benchmark.h>
-#include <nlohmann/json.hpp>
-
-#include <fstream>
 #include <malloc.h>
 #include <tbb/global_control.h>
 
@@ -30,6 +27,7 @@
 #include "bench/bench_main.hpp"
 #include "bench/bench_scene.hpp"
 #include "engine/simulation.hpp"
+#include "tests/engine/scene_builders.hpp"  // shipped_scene_json: the shipped scene files
 
 namespace {
 
@@ -189,13 +187,7 @@ void sort_step_benchmark(benchmark::State& state, const SceneConfig& scene) {
 
 // The shipped H_i = 300 m glacier (18,000 particles), which also carries the gate records and
 // the piston marker, and whose grid box includes the air above the step.
-SceneConfig glacier_scene() {
-  std::ifstream f(std::string(CREVASSE_SOURCE_DIR) + "/studies/scenes/glacier_2d_H300.json");
-  nlohmann::json j = nlohmann::json::parse(f);
-  j["output"]["vtu_interval"] = 0.0;
-  j["output"]["png"] = false;
-  return scene_from_json(j);
-}
+SceneConfig glacier_scene() { return scene_from_json(test::shipped_scene_json("glacier_2d_H300.json")); }
 
 void register_all() {
   for (int dim : {2, 3}) {

@@ -656,28 +656,33 @@ void Simulation<Dim>::grid_to_particle() {
 // would widen every crack by a cell each time it opens further.
 // Three passes, fused with G2P (issue 6): (1) one coloured sweep gathers v and C and scatters
 // (1 − D) m ΔJ and (1 − D) m with the same weights; (2) per node, the average; (3) the update
-// sweep interpolates ΔJ̄ back, recomputing ΔJ_p from C (unchanged since (1)). 1 − D = e^{−ζ ε_v^p}
-// is kept per particle from (1) to (3), where the return mapping uses it as its softening factor
-// too: one exponential per particle and step instead of four.
+// sweep interpolates ΔJ̄ back, recomputing ΔJ_p from C (unchanged since (1)). The softening
+// factor e^{−ζ ε_v^p} (= 1 − D) is kept per particle from (1) to (3), where the return mapping
+// uses it for its cap check and shear strength: a particle that stays off the cap evaluates one
+// exponential per step instead of three, and none while intact (e^{−ζ·0} = 1 is not evaluated).
+template <int Dim>
+bool Simulation<Dim>::averaging_weights_damage() const {
+  // Broken ice is left out of the average only once it can break: not while settling, not
+  // without softening.
+  return particles_.has_plastic_state() && plastic_.softening_zeta > 0.0 && !settling_;
+}
+
 template <int Dim>
 void Simulation<Dim>::gather_velocities_and_scatter_volume() {
   auto& P = particles_;
   const double inv_dx = 1.0 / scene_.dx;
-  volume_damage_ = !P.eps_v_p.empty() && plastic_.softening_zeta > 0.0 && !settling_;
-  const bool damage = volume_damage_;
+  const bool damage = averaging_weights_damage();
   grid_aux_.assign(2 * grid_.node_count(), 0.0);  // interleaved (Σ w m (1−D) ΔJ, Σ w m (1−D))
   const bool plastic = !P.eps_v_p.empty();
-  intact_.resize(plastic ? P.size() : 0);
+  softening_.resize(plastic ? P.size() : 0);
   for_each_particle_coloured([&](std::uint32_t p) {
     const Vec<Dim> xg = P.x[p] * inv_dx;
     const StencilWeights<Dim> w(xg);
     gather_velocity(p, w, xg);
     const double dj = (Mat<Dim>::Identity() + dt_ * P.C[p]).determinant();
-    // Without softening (ζ = 0) or while settling the weight is 1; then e^{−ζ ε} is 1 as well,
-    // or no return mapping runs.
-    const double intact = damage ? softening_factor(plastic_, P.eps_v_p[p]) : 1.0;
-    if (plastic) intact_[p] = intact;
-    const double wm = P.mass[p] * intact;
+    const double f = plastic ? softening_factor(plastic_, P.eps_v_p[p]) : 1.0;
+    if (plastic) softening_[p] = f;
+    const double wm = P.mass[p] * (damage ? f : 1.0);
     const IVec<Dim> base = w.base();
     for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
       const std::size_t f = 2 * grid_.flat(base + off);
@@ -721,13 +726,13 @@ template <int Dim>
 template <bool Plastic>
 void Simulation<Dim>::update_all_particles() {
   const double inv_dx = 1.0 / scene_.dx;
-  const bool damage = volume_damage_;
-  const bool stored = !intact_.empty();
+  const bool damage = averaging_weights_damage();
+  const bool plastic = !softening_.empty();
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, particles_.size(), kGrain), [&](const auto& r) {
     for (std::size_t p = r.begin(); p != r.end(); ++p) {
       const StencilWeights<Dim> w(Vec<Dim>(particles_.x[p] * inv_dx));
-      const double intact = stored ? intact_[p] : 1.0;
-      update_particle<Plastic>(p, averaged_volume_scale(p, w, damage ? intact : 1.0), intact);
+      const double f = plastic ? softening_[p] : 1.0;
+      update_particle<Plastic>(p, averaged_volume_scale(p, w, damage ? f : 1.0), f);
     }
   });
   finish_step<Plastic>();

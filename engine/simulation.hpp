@@ -105,12 +105,13 @@ class Simulation {
   void gather_velocity(std::size_t p, const StencilWeights<Dim>& w, const Vec<Dim>& xg);
   template <bool Plastic>
   void update_particle(std::size_t p, double volume_scale, double softening);  // softening: e^{−ζ ε_v^p}
-  // ΔJ-bar volume averaging, fused into the G2P sweeps (explained above gather_velocities_and_scatter_volume in simulation.cpp):
-  // gather v, C and scatter the weighted ΔJ in one coloured sweep; normalise per node; the
-  // update sweep interpolates ΔJ̄ back and updates the particle at once.
+  // ΔJ-bar volume averaging fused into the G2P sweeps (simulation.cpp explains it): gather v, C
+  // and scatter the weighted ΔJ in one coloured sweep; normalise per node; the update sweep
+  // interpolates ΔJ̄ back and updates the particle at once.
   void gather_velocities_and_scatter_volume();
   void normalise_volume_average();
   double averaged_volume_scale(std::size_t p, const StencilWeights<Dim>& w, double intact) const;
+  bool averaging_weights_damage() const;  // the averaging weights each particle by 1 − D
   template <bool Plastic>
   void update_all_particles();
   template <bool Plastic>
@@ -145,8 +146,7 @@ class Simulation {
   // Volume averaging scratch (reused every step): per node (Σ w m (1−D) ΔJ, Σ w m (1−D)), then
   // (averaged ΔJ, whether the node carries one).
   std::vector<double> grid_aux_;
-  std::vector<double> intact_;  // per particle e^{−ζ ε_v^p} (plastic scenes), from G2P to the update
-  bool volume_damage_ = false;  // this step's averaging weights particles by 1 − D
+  std::vector<double> softening_;  // per particle e^{−ζ ε_v^p} (plastic scenes), from G2P to the update
   std::vector<double> drive_node_mass_;  // per node: mass from the driven layer (drive_grid)
 
   Vec<Dim> domain_lo_, domain_hi_;

@@ -134,16 +134,21 @@ void expect_thread_count_independent(const SceneConfig& scene, int steps) {
   EXPECT_GT(std::count_if(one.eps_v_p.begin(), one.eps_v_p.end(), [](double e) { return e > 0.0; }), 0);
 }
 
-// 2D: a weak, jittered glacier through a sorting step (every 100 steps) and the outflow, with
-// damage; more particles than one 1024-particle block, so the slab sort runs in several blocks.
+// A weak glacier (it breaks within the run) with jittered particles, so that no two particles
+// share a lattice position and the sort has real work.
+SceneConfig jittered_glacier(test::SmallGlacier g, double jitter) {
+  SceneConfig s = test::small_glacier_scene(g);
+  s.jitter = jitter;
+  return test::finish(s);
+}
+
+// 2D: 1,500 steps cross 15 sorting steps; 1,200 particles are more than one 1,024-particle
+// block, so the slab sort runs in two blocks.
 TEST(ThreadCount, TwoDimensionalGlacierIsBitwiseIdenticalOnOneAndTwoThreads) {
   test::SmallGlacier g;
   g.cohesion_ratio = 0.05;
   g.cells_per_thickness = 10.0;
-  SceneConfig s = test::small_glacier_scene(g);
-  s.jitter = 0.4;
-  s = test::finish(s);
-  expect_thread_count_independent<2>(s, 1500);
+  expect_thread_count_independent<2>(jittered_glacier(g, 0.4), 1500);
 }
 
 TEST(ThreadCount, ThreeDimensionalGlacierIsBitwiseIdenticalOnOneAndTwoThreads) {
@@ -153,10 +158,7 @@ TEST(ThreadCount, ThreeDimensionalGlacierIsBitwiseIdenticalOnOneAndTwoThreads) {
   g.width_ratio = 0.5;
   g.upstream_ratio = 2.0;
   g.downstream_ratio = 2.0;
-  SceneConfig s = test::small_glacier_scene(g);
-  s.jitter = 0.3;
-  s = test::finish(s);
-  expect_thread_count_independent<3>(s, 400);
+  expect_thread_count_independent<3>(jittered_glacier(g, 0.3), 400);
 }
 
 }  // namespace
