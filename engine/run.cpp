@@ -54,6 +54,14 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
   const double snap_interval = obs ? obs->snapshot_interval_s() : 0.0;
   double next_snap = snap_interval;
 
+  const bool watch_stall = scene.gate_length > 0 && scene.has(Effect::drive) && scene.drive_speed > 0;
+  GateStallWatch stall;
+  if (watch_stall) {
+    stall.window_s = 2.0 * scene.ice_thickness / scene.drive_speed;
+    stall.min_growth_m = scene.dx;
+    stall.ramp_s = scene.drive_ramp_time;
+  }
+
   double last_report = 0.0;
   std::int64_t last_steps = 0, last_psteps = 0;
   while (true) {
@@ -63,6 +71,7 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
     if (scene.front_past_step > 0 && sim.steps() % 20 == 0) ice_front = sim.ice_front_x();
     if (scene.front_past_step > 0 && ice_front >= target_front) { out.stop_reason = "front_past_step"; break; }
     if (scene.gate_length > 0 && sim.gate_passed_length() >= scene.gate_length) { out.stop_reason = "gate_length"; break; }
+    if (watch_stall && stall.stalled(sim.time(), sim.gate_passed_length())) { out.stop_reason = "gate_stalled"; break; }
     if (scene.max_steps > 0 && sim.steps() >= scene.max_steps) { out.stop_reason = "max_steps"; break; }
     if (sim.particles().size() == 0) { out.stop_reason = "no_ice_left"; break; }
     sim.step();

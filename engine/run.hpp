@@ -43,8 +43,31 @@ class RunObserver {
   virtual double progress_interval_s() const { return 2.0; }
 };
 
+// The stop rule for a gate run whose ice no longer reaches the gate. The piston can leave the
+// last block of a strong slab behind on the plateau (measured: H_i = 400 m, Π = 1, V_x = 2 m/s,
+// 99 % of run.gate_length passed, then nothing for the next 190,000 simulated seconds until
+// the wall-time limit); a run asked for all of the upstream ice never gets its last cells.
+// stalled() is true once, after the drive's ramp, the passed length has grown by less than
+// `min_growth_m` over `window_s` of simulated time; run_scene() then stops with
+// "gate_stalled" and the ice that did pass is measured as usual.
+struct GateStallWatch {
+  double window_s = 0.0;      // 2·H_i/V_x: the time the piston takes to push two ice thicknesses
+  double min_growth_m = 0.0;  // one cell
+  double ramp_s = 0.0;        // no verdict while the piston speeds up
+  double mark_length_m = -1.0, mark_time_s = 0.0;
+  bool stalled(double time_s, double passed_m) {
+    if (time_s < ramp_s) return false;
+    if (mark_length_m < 0.0 || passed_m >= mark_length_m + min_growth_m) {
+      mark_length_m = passed_m;
+      mark_time_s = time_s;
+      return false;
+    }
+    return time_s - mark_time_s > window_s;
+  }
+};
+
 struct RunSummary {
-  std::string stop_reason;  // "front_past_step", "gate_length", "end_time", "max_steps", "cancelled", "no_ice_left"
+  std::string stop_reason;  // "front_past_step", "gate_length", "gate_stalled", "end_time", "max_steps", "cancelled", "no_ice_left"
   std::int64_t steps = 0;
   std::int64_t particle_steps = 0;
   std::int64_t return_map_evaluations = 0;

@@ -25,7 +25,7 @@ fi
 studies=("$@")
 if [[ ${#studies[@]} -eq 0 ]]; then
   studies=(spacing_vs_cohesion spacing_replicas spacing_resolution slope step_length three_d
-           two_d_long three_d_long accuracy_cost)
+           two_d_long three_d_long drive_speed_long accuracy_drive accuracy_cost)
 fi
 
 for name in "${studies[@]}"; do
@@ -67,10 +67,14 @@ for name in "${studies[@]}"; do
       # The long-window 3D cases on the diagram of their 2D counterpart (run two_d_long first).
       $crevasse plot results/two_d_long.db --out "results/${name}_figures" --add-cases "$db"
       ;;
-    two_d_long)
+    two_d_long | drive_speed_long | accuracy_drive)
+      # drive_speed_long: compared case by case (results/README.md, "Drive speed");
+      # accuracy_drive: its rows join accuracy_cost's table.
       ;;
     accuracy_cost)
-      $crevasse accuracy "$db" --out "results/${name}"
+      added=()
+      [[ -f results/accuracy_drive.db ]] && added=(--add-cases results/accuracy_drive.db)
+      $crevasse accuracy "$db" --out "results/${name}" "${added[@]}"
       ;;
   esac
 done

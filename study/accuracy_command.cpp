@@ -23,7 +23,9 @@ namespace {
 
 struct CostRow {
   const CaseRecord* c = nullptr;
+  std::string label;  // the case index, prefixed with its database's stem for --add-cases
   double dx_m = 0.0, cfl = 0.0;
+  std::optional<double> drive_m_s;  // piston speed V_x (absent when the scene has no drive)
   int ppc_axis = 0;
   std::optional<double> wall_s, peak_mb;
   std::optional<long long> steps, particle_steps;
@@ -38,37 +40,53 @@ std::string change_pct(const std::optional<double>& v, const std::optional<doubl
   return buf;
 }
 
-}  // namespace
-
-std::vector<fs::path> accuracy_report(const AccuracyCommandOptions& opt, std::string* table) {
-  Store store = Store::open_reader(opt.db_path);
-  const std::vector<CaseRecord> cases = read_case_records(store);
+// The finished cases of one database with their numerics and cost; `prefix` labels them.
+void read_cost_rows(const std::string& db_path, const std::string& prefix,
+                    std::vector<CaseRecord>& cases, std::vector<CostRow>& rows) {
+  Store store = Store::open_reader(db_path);
+  cases = read_case_records(store);
   std::map<std::string, CostRow> by_id;
-  {
-    Statement s(store.handle(),
-                "SELECT case_id, scene_json, wall_s, peak_rss_bytes, steps, particle_steps "
-                "FROM cases");
-    while (s.step()) {
-      CostRow r;
-      const auto scene = nlohmann::json::parse(s.text(1));
-      r.dx_m = scene.at("numerics").at("dx").get<double>();
-      r.ppc_axis = scene.at("numerics").at("particles_per_cell_axis").get<int>();
-      r.cfl = scene.at("numerics").at("cfl").get<double>();
-      if (!s.is_null(2)) r.wall_s = s.real(2);
-      if (!s.is_null(3)) r.peak_mb = s.real(3) / 1048576.0;
-      if (!s.is_null(4)) r.steps = s.integer(4);
-      if (!s.is_null(5)) r.particle_steps = s.integer(5);
-      by_id[s.text(0)] = r;
-    }
+  Statement s(store.handle(),
+              "SELECT case_id, scene_json, wall_s, peak_rss_bytes, steps, particle_steps "
+              "FROM cases");
+  while (s.step()) {
+    CostRow r;
+    const auto scene = nlohmann::json::parse(s.text(1));
+    r.dx_m = scene.at("numerics").at("dx").get<double>();
+    r.ppc_axis = scene.at("numerics").at("particles_per_cell_axis").get<int>();
+    r.cfl = scene.at("numerics").at("cfl").get<double>();
+    if (scene.contains("drive") && scene.at("drive").contains("speed"))
+      r.drive_m_s = scene.at("drive").at("speed").get<double>();
+    if (!s.is_null(2)) r.wall_s = s.real(2);
+    if (!s.is_null(3)) r.peak_mb = s.real(3) / 1048576.0;
+    if (!s.is_null(4)) r.steps = s.integer(4);
+    if (!s.is_null(5)) r.particle_steps = s.integer(5);
+    by_id[s.text(0)] = r;
   }
-  std::vector<CostRow> rows;
   for (const CaseRecord& c : cases) {
     if (c.status != "done") continue;
     CostRow r = by_id.at(c.case_id);
     r.c = &c;
+    r.label = prefix + std::to_string(c.case_index);
     rows.push_back(r);
   }
-  if (rows.empty()) throw InputError(opt.db_path + ": no finished case; run the study first");
+}
+
+}  // namespace
+
+std::vector<fs::path> accuracy_report(const AccuracyCommandOptions& opt, std::string* table) {
+  // Each database's records in their own vector, which the rows point into.
+  std::vector<std::vector<CaseRecord>> cases(1 + opt.add_dbs.size());
+  std::vector<CostRow> rows;
+  read_cost_rows(opt.db_path, "", cases[0], rows);
+  const std::size_t main_rows = rows.size();
+  for (std::size_t i = 0; i < opt.add_dbs.size(); ++i) {
+    const std::size_t before = rows.size();
+    read_cost_rows(opt.add_dbs[i], fs::path(opt.add_dbs[i]).stem().string() + ":", cases[i + 1], rows);
+    if (rows.size() == before)
+      throw InputError("--add-cases: " + opt.add_dbs[i] + " has no finished case");
+  }
+  if (main_rows == 0) throw InputError(opt.db_path + ": no finished case; run the study first");
   // Coarsest grid first (the figure's colours and legend follow this order), then case order.
   std::stable_sort(rows.begin(), rows.end(),
                    [](const CostRow& a, const CostRow& b) { return a.dx_m > b.dx_m; });
@@ -76,8 +94,8 @@ std::vector<fs::path> accuracy_report(const AccuracyCommandOptions& opt, std::st
   // The reference: the given case, else the finest run that has a spacing.
   const CostRow* ref = nullptr;
   if (opt.reference_index) {
-    for (const CostRow& r : rows)
-      if (r.c->case_index == *opt.reference_index) ref = &r;
+    for (std::size_t i = 0; i < rows.size(); ++i)
+      if (rows[i].label == std::to_string(*opt.reference_index)) ref = &rows[i];
     if (!ref)
       throw InputError("--reference: no finished case with index " +
                        std::to_string(*opt.reference_index) + " in " + opt.db_path);
@@ -96,16 +114,17 @@ std::vector<fs::path> accuracy_report(const AccuracyCommandOptions& opt, std::st
   const fs::path csv_path = fs::path(opt.out_dir) / "accuracy_cost.csv";
   const fs::path md_path = fs::path(opt.out_dir) / "accuracy_cost.md";
   CsvFile csv(csv_path, "--out");
-  csv.row({"case_index", "dx_m", "particles_per_cell_axis", "cfl", "steps", "particle_steps",
+  csv.row({"case", "dx_m", "particles_per_cell_axis", "cfl", "drive_speed_m_s", "steps", "particle_steps",
            "wall_s", "peak_rss_mib", "crevasses", "spacing_median_over_h", "depth_median_over_h",
            "spacing_change_vs_reference", "depth_change_vs_reference", "note"});
   std::ostringstream md;
   md << "Reference: case " << ref->c->case_index << " (dx = " << short_number(ref->dx_m)
      << " m, " << ref->ppc_axis << " particles per cell per axis, CFL " << short_number(ref->cfl)
-     << "). Changes are of the median against the reference's.\n\n"
-     << "| case | dx [m] | ppc/axis | CFL | steps | particle-steps | wall [s] | peak RSS [MiB] | "
-        "crevasses | L_p/H_i | change | D_p/H_i | change | note |\n"
-     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+     << ", V_x = " << cell(ref->drive_m_s)
+     << " m/s). Changes are of the median against the reference's.\n\n"
+     << "| case | dx [m] | ppc/axis | CFL | V_x [m/s] | steps | particle-steps | wall [s] | "
+        "peak RSS [MiB] | crevasses | L_p/H_i | change | D_p/H_i | change | note |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   std::vector<analysis::RegimePoint> points;
   for (const CostRow& r : rows) {
     const CaseRecord& c = *r.c;
@@ -116,12 +135,12 @@ std::vector<fs::path> accuracy_report(const AccuracyCommandOptions& opt, std::st
     if (&r == ref) note += (note.empty() ? "" : "; ") + std::string("reference");
     const std::string steps = r.steps ? std::to_string(*r.steps) : "-";
     const std::string psteps = r.particle_steps ? short_number(static_cast<double>(*r.particle_steps)) : "-";
-    csv.row({std::to_string(c.case_index), short_number(r.dx_m), std::to_string(r.ppc_axis),
-             short_number(r.cfl), steps, r.particle_steps ? std::to_string(*r.particle_steps) : "",
+    csv.row({r.label, short_number(r.dx_m), std::to_string(r.ppc_axis),
+             short_number(r.cfl), cell(r.drive_m_s), steps, r.particle_steps ? std::to_string(*r.particle_steps) : "",
              cell(r.wall_s), cell(r.peak_mb), std::to_string(c.crevasse_count), cell(l), cell(d),
              change_pct(l, lr), change_pct(d, dr), note});
-    md << "| " << c.case_index << " | " << short_number(r.dx_m) << " | " << r.ppc_axis << " | "
-       << short_number(r.cfl) << " | " << steps << " | " << psteps << " | " << cell(r.wall_s)
+    md << "| " << r.label << " | " << short_number(r.dx_m) << " | " << r.ppc_axis << " | "
+       << short_number(r.cfl) << " | " << cell(r.drive_m_s) << " | " << steps << " | " << psteps << " | " << cell(r.wall_s)
        << " | " << cell(r.peak_mb) << " | " << c.crevasse_count << " | " << cell(l) << " | "
        << change_pct(l, lr) << " | " << cell(d) << " | " << change_pct(d, dr) << " | " << note
        << " |\n";
@@ -129,6 +148,7 @@ std::vector<fs::path> accuracy_report(const AccuracyCommandOptions& opt, std::st
     analysis::RegimePoint p;
     p.pi = *r.wall_s;
     p.group = "dx = " + short_number(r.dx_m) + " m";
+    if (r.drive_m_s != ref->drive_m_s) p.group += ", V_x = " + cell(r.drive_m_s) + " m/s";
     if (l) {
       p.y = *l;
       const auto& q = c.quartiles(Quantity::spacing);

@@ -124,6 +124,7 @@ int main(int argc, char** argv) {
   auto* accuracy = app.add_subcommand("accuracy", "Accuracy against cost of a study over the numerics (studies/accuracy_cost.json): table and figure");
   accuracy->add_option("db", accuracy_opt.db_path, "Study database")->required();
   accuracy->add_option("--out", accuracy_opt.out_dir, "Output directory")->required();
+  accuracy->add_option("--add-cases", accuracy_opt.add_dbs, "More databases whose finished cases are added as rows <stem>:<index> (repeatable)");
   accuracy->add_option("--reference", accuracy_opt.reference_index, "Case index of the reference run (default: the finest run with a spacing)");
 
   // Parse errors on one line, like every other refusal.

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <iostream>
 #include <vector>
 
 #include "engine/error.hpp"
@@ -114,6 +115,53 @@ TEST(Gate, GateLengthStopsTheRun) {
   EXPECT_GE(r.final_snapshot.gate_passed_length_m, 30.0);
   EXPECT_LT(r.final_snapshot.gate_passed_length_m, 30.0 + 2.0 * 5.0);
   EXPECT_LT(r.sim_time_s, 200.0);
+}
+
+// The stall rule alone: no verdict during the ramp; steady passing never stalls; less than
+// one cell of growth for longer than the window does, and any cell of growth restarts it.
+TEST(Gate, StallWatchNeedsAWindowWithoutACellOfGrowth) {
+  GateStallWatch w;
+  w.window_s = 50.0;
+  w.min_growth_m = 10.0;
+  w.ramp_s = 20.0;
+  EXPECT_FALSE(w.stalled(0.0, 0.0));
+  EXPECT_FALSE(w.stalled(19.0, 0.0));  // ramp
+  // Passing at 0.5 m/s: the window restarts at every 10 m (the last at t = 480 s, 230 m).
+  for (double t = 20.0; t < 500.0; t += 1.0) ASSERT_FALSE(w.stalled(t, 0.5 * (t - 20.0))) << t;
+  // Then it stops short of 240 m: 9.9 m is less than a cell, so the window runs from 480 s.
+  EXPECT_FALSE(w.stalled(500.0, 239.9));
+  EXPECT_FALSE(w.stalled(529.0, 239.9));
+  EXPECT_TRUE(w.stalled(531.0, 239.9));
+  // One cell more restarts the window.
+  EXPECT_FALSE(w.stalled(532.0, 240.0));
+  EXPECT_FALSE(w.stalled(580.0, 245.0));
+  EXPECT_TRUE(w.stalled(582.5, 245.0));
+}
+
+// A run whose ice stops reaching the gate stops. Here a fixed grip (a velocity box at rest
+// across the whole height at the top of the step) holds the ice back, so nothing passes after
+// the ramp: without the stall rule the run would go on to its end time (the guard of 400 s; at
+// H_i = 400 m, V_x = 2 m/s a study case ran into its 30 min wall-time limit this way, with the
+// last block left on the plateau); with it, it stops as "gate_stalled" one window
+// (2·H_i/V_x = 25 s) after the passing stopped and keeps what passed for the measurement.
+TEST(Gate, ARunWhoseIceStopsReachingTheGateStops) {
+  test::SmallGlacier g;
+  g.end_time = 400.0;
+  SceneConfig scene = test::small_glacier_scene(g);
+  scene.gate_length = 0.5 * scene.upstream_length;
+  scene.effects.push_back(Effect::velocity_boundaries);
+  VelocityBox hold;
+  hold.min = {scene.gate_x() - 2.0 * scene.dx, -1e4, -1e4};
+  hold.max = {scene.gate_x() + 2.0 * scene.dx, 1e4, 1e4};
+  hold.velocity = {0.0, 0.0, 0.0};
+  scene.velocity_boxes = {hold};
+  scene = test::finish(scene);
+  const RunSummary r = run_scene(scene);
+  EXPECT_EQ(r.stop_reason, "gate_stalled");
+  const double window = 2.0 * scene.ice_thickness / scene.drive_speed;
+  EXPECT_GT(r.sim_time_s, scene.drive_ramp_time + window);
+  EXPECT_LT(r.sim_time_s, scene.drive_ramp_time + 2.0 * window);
+  EXPECT_LT(r.final_snapshot.gate_passed_length_m, scene.dx);
 }
 
 TEST(Gate, GateLengthIsRefusedWhereThereIsNoGate) {

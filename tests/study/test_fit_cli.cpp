@@ -30,10 +30,12 @@ struct FakeResult {
 // about the median.
 void write_synthetic_db(const std::filesystem::path& db, int n_pi,
                         const std::vector<double>& thicknesses,
-                        const std::function<FakeResult(const StudyCase&)>& make) {
+                        const std::function<FakeResult(const StudyCase&)>& make,
+                        const std::function<void(nlohmann::json&)>& edit = {}) {
   nlohmann::json j = test::tiny_study(n_pi, 100, "synthetic");
   j["sweep"]["thickness"] = thicknesses;
   if (n_pi == 1) j["sweep"]["cohesion_ratio"] = {0.2};
+  if (edit) edit(j);
   const Study study = test::parse(j);
   Store store = Store::open_writer(db);
   store.init_study(study);
@@ -336,6 +338,39 @@ TEST(FitCli, AccuracyTableAgainstTheFinestRun) {
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 6) << csv;  // header + 5 cases
   expect_one_line_error(test::run_cli(dir.path(), "accuracy s.db --out acc --reference 99"),
                         "--reference");
+}
+
+// --add-cases: the finished cases of another database (here the same study at a faster drive)
+// become rows labelled <stem>:<index>, with their drive speed, compared with the reference of
+// the first database.
+TEST(FitCli, AccuracyTableAddsTheCasesOfAnotherDatabase) {
+  test::ScratchDir dir("fit");
+  const auto spacing = [](double l) {
+    return [l](const StudyCase&) {
+      FakeResult f;
+      f.spacing_over_h = l;
+      f.depth_over_h = 1.0;
+      return f;
+    };
+  };
+  write_synthetic_db(dir / "s.db", 1, {100.0}, spacing(1.0),
+                     [](nlohmann::json& j) { j["fixed"]["/drive/speed"] = 4.0; });
+  write_synthetic_db(dir / "fast.db", 1, {100.0}, spacing(1.25),
+                     [](nlohmann::json& j) { j["fixed"]["/drive/speed"] = 8.0; });
+  const test::CliResult r =
+      test::run_cli(dir.path(), "accuracy s.db --add-cases fast.db --out acc --reference 0");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string md = test::read_file(dir / "acc" / "accuracy_cost.md");
+  EXPECT_NE(md.find("V_x = 4 m/s). Changes"), std::string::npos) << md;
+  const auto fast = md.find("| fast:0 |");
+  ASSERT_NE(fast, std::string::npos) << md;
+  const std::string fast_row = md.substr(fast, md.find('\n', fast) - fast);
+  EXPECT_NE(fast_row.find("| 8 |"), std::string::npos) << fast_row;
+  EXPECT_NE(fast_row.find("| 1.25 | +25.0% |"), std::string::npos) << fast_row;
+  const std::string csv = test::read_file(dir / "acc" / "accuracy_cost.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3) << csv;  // header + 1 + 1
+  expect_one_line_error(test::run_cli(dir.path(), "accuracy s.db --add-cases none.db --out acc"),
+                        "none.db");
 }
 
 double number_after(const std::string& text, const std::string& label) {

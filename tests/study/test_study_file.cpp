@@ -3,9 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <set>
 
+#include <nlohmann/json.hpp>
+
 #include "engine/error.hpp"
+#include "engine/scene.hpp"
 #include "study/shard.hpp"
 #include "study/study_file.hpp"
 #include "study_test_support.hpp"
@@ -352,16 +356,20 @@ TEST(Shard, ParsesAndRefuses) {
 namespace crevasse {
 namespace {
 
-// Every study shipped in studies/ loads, and quick.json spans weak to strong ice in 2D.
+// Every study shipped in studies/ loads (named after its file), and quick.json spans weak to
+// strong ice in 2D.
 TEST(ShippedStudies, AllLoadAndQuickSpansWeakToStrongIce) {
   const std::filesystem::path dir = std::filesystem::path(CREVASSE_SOURCE_DIR) / "studies";
-  for (const char* name :
-       {"quick", "spacing_vs_cohesion", "slope", "step_length", "three_d", "accuracy_cost"}) {
-    SCOPED_TRACE(name);
-    const Study s = load_study_file(dir / (std::string(name) + ".json"));
-    EXPECT_EQ(s.name, name);
+  int loaded = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() != ".json") continue;
+    SCOPED_TRACE(entry.path().string());
+    const Study s = load_study_file(entry.path());
+    EXPECT_EQ(s.name, entry.path().stem().string());
     EXPECT_FALSE(s.cases.empty());
+    ++loaded;
   }
+  EXPECT_GE(loaded, 12);  // the studies of results/README.md
   const Study quick = load_study_file(dir / "quick.json");
   double lo = 1e9, hi = 0;
   for (const auto& c : quick.cases) {
@@ -373,6 +381,22 @@ TEST(ShippedStudies, AllLoadAndQuickSpansWeakToStrongIce) {
   EXPECT_LE(lo, 0.06);
   EXPECT_GE(hi, 0.9);
   EXPECT_LE(quick.cases.size(), 12u);
+  // accuracy_drive's rows are accuracy_cost's cases at other drive speeds: the same scene
+  // apart from drive.speed, so the table compares like with like.
+  const Study acc = load_study_file(dir / "accuracy_cost.json");
+  const Study drive = load_study_file(dir / "accuracy_drive.json");
+  for (const auto& c : drive.cases) {
+    SCOPED_TRACE(c.label);
+    EXPECT_NE(c.scene.drive_speed, 4.0);
+    nlohmann::json faster = scene_to_json(c.scene);
+    int matched = 0;
+    for (const auto& a : acc.cases) {
+      nlohmann::json base = scene_to_json(a.scene);
+      base["drive"]["speed"] = faster["drive"]["speed"];
+      matched += base == faster;
+    }
+    EXPECT_EQ(matched, 1);
+  }
   // three_d runs at cohesion ratios of quick's cases.
   const Study three = load_study_file(dir / "three_d.json");
   for (const auto& c : three.cases) {
