@@ -11,8 +11,9 @@
 # "Shipped studies"): spacing_vs_cohesion 36 min, spacing_replicas 9 min,
 # spacing_resolution 23 min, slope 5 min, step_length 6 min, three_d 31 min (3 cases),
 # two_d_long 3 min, three_d_long 38 min (2 cases, 19 min each side by side),
-# accuracy_cost 28 min (one case at a time, so that each case's wall time and peak memory
-# are its own).
+# drive_speed_long 29 min, drive_speed_replicas 23 min, accuracy_drive 6 min and
+# accuracy_cost 28 min (these two one case at a time, so that each case's wall time and peak
+# memory are its own).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 crevasse=./build/study/crevasse
@@ -25,7 +26,8 @@ fi
 studies=("$@")
 if [[ ${#studies[@]} -eq 0 ]]; then
   studies=(spacing_vs_cohesion spacing_replicas spacing_resolution slope step_length three_d
-           two_d_long three_d_long drive_speed_long accuracy_drive accuracy_cost)
+           two_d_long three_d_long drive_speed_long drive_speed_replicas accuracy_drive
+           accuracy_cost)
 fi
 
 for name in "${studies[@]}"; do
@@ -67,8 +69,8 @@ for name in "${studies[@]}"; do
       # The long-window 3D cases on the diagram of their 2D counterpart (run two_d_long first).
       $crevasse plot results/two_d_long.db --out "results/${name}_figures" --add-cases "$db"
       ;;
-    two_d_long | drive_speed_long | accuracy_drive)
-      # drive_speed_long: compared case by case (results/README.md, "Drive speed");
+    two_d_long | drive_speed_long | drive_speed_replicas | accuracy_drive)
+      # drive_speed_*: tables by scripts/drive_speed_table.py (results/README.md, "Drive speed");
       # accuracy_drive: its rows join accuracy_cost's table.
       ;;
     accuracy_cost)
