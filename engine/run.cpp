@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 
 #include "engine/error.hpp"
@@ -82,10 +83,11 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
     }
     const double wall = std::chrono::duration<double>(clock::now() - t0).count();
     if (scene.wall_time_limit > 0 && wall > scene.wall_time_limit) {
-      throw SimulationError("time limit: run.wall_time_limit = " + std::to_string(scene.wall_time_limit) +
-                            " s reached at t = " + std::to_string(sim.time()) + " s, step " +
-                            std::to_string(sim.steps()) + " (" +
-                            std::to_string(static_cast<int>(100 * fraction())) + "% done)");
+      char msg[200];
+      std::snprintf(msg, sizeof msg, "time limit: run.wall_time_limit = %g s reached at t = %.6g s, step %lld (%d%% done)",
+                    scene.wall_time_limit, sim.time(), static_cast<long long>(sim.steps()),
+                    static_cast<int>(100 * fraction()));
+      throw SimulationError(msg);
     }
     if (!checkpoint.empty() && wall - last_checkpoint_wall >= obs->checkpoint_interval_s()) {
       sim.save_checkpoint(checkpoint);

@@ -164,6 +164,25 @@ TEST(Gate, ARunWhoseIceStopsReachingTheGateStops) {
   EXPECT_LT(r.final_snapshot.gate_passed_length_m, scene.dx);
 }
 
+// The wall-time limit ends a run with one readable line: the limit as given, the simulated
+// time and step reached, and how far the stop rules had got.
+TEST(Gate, WallTimeLimitSaysWhereTheRunWas) {
+  test::SmallGlacier g;
+  SceneConfig scene = test::small_glacier_scene(g);
+  scene.gate_length = 0.5 * scene.upstream_length;
+  scene.wall_time_limit = 0.05;
+  scene = test::finish(scene);
+  try {
+    run_scene(scene);
+    FAIL() << "the run ended before its 0.05 s wall-time limit";
+  } catch (const SimulationError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind("time limit: run.wall_time_limit = 0.05 s reached at t = ", 0), 0u) << m;
+    EXPECT_NE(m.find("% done)"), std::string::npos) << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  }
+}
+
 TEST(Gate, GateLengthIsRefusedWhereThereIsNoGate) {
   nlohmann::json j = test::shipped_scene_json();
   j["run"]["gate_length"] = 600.0;  // more than the 500 m slab
