@@ -46,7 +46,8 @@ class RunObserver {
 // The stop rule for a gate run whose ice no longer reaches the gate. The piston can leave the
 // last block of a strong slab behind on the plateau (measured: H_i = 400 m, Π = 1, V_x = 2 m/s,
 // 99 % of run.gate_length passed, then nothing for the next 190,000 simulated seconds until
-// the wall-time limit); a run asked for all of the upstream ice never gets its last cells.
+// the wall-time limit). A run asked for the whole slab (gate_length = upstream_length) stops
+// here too: the passed length, a sum of particle volumes, falls short of it by round-off.
 // stalled() is true once, after the drive's ramp, the passed length has grown by less than
 // `min_growth_m` over `window_s` of simulated time; run_scene() then stops with
 // "gate_stalled" and the ice that did pass is measured as usual.

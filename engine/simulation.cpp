@@ -685,9 +685,9 @@ void Simulation<Dim>::gather_velocities_and_scatter_volume() {
     const double wm = P.mass[p] * (damage ? f : 1.0);
     const IVec<Dim> base = w.base();
     for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
-      const std::size_t f = 2 * grid_.flat(base + off);
-      grid_aux_[f] += wt * wm * dj;
-      grid_aux_[f + 1] += wt * wm;
+      const std::size_t node = 2 * grid_.flat(base + off);
+      grid_aux_[node] += wt * wm * dj;
+      grid_aux_[node + 1] += wt * wm;
     });
   });
 }
