@@ -53,39 +53,56 @@ inline constexpr double kIsotropicSpread2 = 1e-150;
 // least r, so normalising cancels nothing. The other column is its rotation by −90°, so U is a
 // proper rotation (det U = +1) and orthonormal to round-off; columns in ascending order of
 // eigenvalue, as Eigen's solver returns them.
-inline PrincipalStretch<2> principal_hencky_2d(const Mat<2>& F) {
-  const double f00 = F(0, 0), f01 = F(0, 1), f10 = F(1, 0), f11 = F(1, 1);
+// The closed form in three parts, so that the engine's 2D update can run the arithmetic over a
+// block of particles in vector registers and only the two logarithms one by one
+// (simulation.cpp, update_particles_2d); principal_hencky_2d chains the same parts, so both give
+// the same bits. Part 1: the entries of b − I, its half-trace m, half-spread h, off-diagonal d,
+// r = sqrt(h² + d²) and |det F| − 1.
+struct Hencky2dParts {
+  double m, h, d, r, j_minus_1;
+};
+inline Hencky2dParts hencky_2d_parts(double f00, double f01, double f10, double f11) {
   const double h00 = f00 - 1.0, h11 = f11 - 1.0;
   const double a = h00 * (2.0 + h00) + f01 * f01;
   const double c = h11 * (2.0 + h11) + f10 * f10;
-  const double d = f00 * f10 + f01 * f11;
-  const double m = 0.5 * (a + c);
-  const double h = 0.5 * (a - c);
-  const double r = std::sqrt(h * h + d * d);
-  double j_minus_1 = h00 + h11 + (h00 * h11 - f01 * f10);
-  if (j_minus_1 < -1.0) j_minus_1 = -2.0 - j_minus_1;  // det F < 0: |det F| − 1
+  Hencky2dParts q;
+  q.d = f00 * f10 + f01 * f11;
+  q.m = 0.5 * (a + c);
+  q.h = 0.5 * (a - c);
+  q.r = std::sqrt(q.h * q.h + q.d * q.d);
+  const double j1 = h00 + h11 + (h00 * h11 - f01 * f10);
+  q.j_minus_1 = j1 < -1.0 ? -2.0 - j1 : j1;  // det F < 0: |det F| − 1
+  return q;
+}
+// Part 3: the unit eigenvector (ux, uy) of the larger eigenvalue (U's second column), without
+// branches: both candidate vectors are formed and one is selected, and the isotropic case
+// (r ≤ kIsotropicSpread2, U = I) is selected last, so a block of particles vectorises. The
+// arithmetic of the selected lane is that of the branchy form.
+// Returns whether the spread is resolved (U ≠ I).
+inline bool hencky_2d_frame(const Hencky2dParts& q, double& ux, double& uy) {
+  const bool pos = q.h >= 0.0;
+  double vx = pos ? q.h + q.r : q.d;
+  double vy = pos ? q.d : q.r - q.h;
+  const double inv = 1.0 / std::sqrt(vx * vx + vy * vy);
+  vx *= inv;
+  vy *= inv;
+  const bool spread = q.r > kIsotropicSpread2;
+  ux = spread ? vx : 0.0;
+  uy = spread ? vy : 1.0;
+  return spread;
+}
+inline PrincipalStretch<2> principal_hencky_2d(const Mat<2>& F) {
+  const Hencky2dParts q = hencky_2d_parts(F(0, 0), F(0, 1), F(1, 0), F(1, 1));
   PrincipalStretch<2> out;
-  out.eps[1] = 0.5 * std::log1p(m + r);
-  out.eps[0] = std::log1p(j_minus_1) - out.eps[1];
-  if (r > kIsotropicSpread2) {
-    double vx, vy;
-    if (h >= 0.0) {
-      vx = h + r;
-      vy = d;
-    } else {
-      vx = d;
-      vy = r - h;
-    }
-    const double inv = 1.0 / std::sqrt(vx * vx + vy * vy);
-    vx *= inv;
-    vy *= inv;
-    out.U(0, 0) = vy;
-    out.U(1, 0) = -vx;
-    out.U(0, 1) = vx;
-    out.U(1, 1) = vy;
-  } else {
-    out.U.setIdentity();
-  }
+  // Part 2: the two logarithms.
+  out.eps[1] = 0.5 * std::log1p(q.m + q.r);
+  out.eps[0] = std::log1p(q.j_minus_1) - out.eps[1];
+  double ux, uy;
+  const bool spread = hencky_2d_frame(q, ux, uy);
+  out.U(0, 0) = uy;
+  out.U(1, 0) = spread ? -ux : 0.0;
+  out.U(0, 1) = ux;
+  out.U(1, 1) = uy;
   return out;
 }
 
@@ -115,20 +132,26 @@ inline Vec<Dim> principal_kirchhoff(const ElasticModuli& m, const Vec<Dim>& eps)
   return (2.0 * m.mu * eps.array() + m.lambda * eps.sum()).matrix();
 }
 
+// 2D τ from the principal strains (e0 ≤ e1) and U's second column (ux, uy), in scalars (the
+// engine's 2D block update calls it on a block of particles): τ₀ I + (τ₁ − τ₀) u uᵀ, below.
+inline void kirchhoff_stress_2d(const ElasticModuli& m, double e0, double e1, double ux, double uy,
+                                double& t00, double& t11, double& t01) {
+  const double two_mu = 2.0 * m.mu, lam_tr = m.lambda * (e0 + e1);
+  const double t0 = two_mu * e0 + lam_tr, t1 = two_mu * e1 + lam_tr;
+  const double dt = t1 - t0;
+  t00 = t0 + dt * ux * ux;
+  t11 = t0 + dt * uy * uy;
+  t01 = dt * ux * uy;
+}
+
 // τ = U diag(τ_i) Uᵀ. In 2D, with u = U's second column, U diag(τ₀, τ₁) Uᵀ = τ₀ I + (τ₁ − τ₀) u uᵀ
 // (U orthonormal), which is exactly symmetric and needs 4 products instead of a 2×2×2 chain.
 template <int Dim>
 inline Mat<Dim> kirchhoff_stress(const ElasticModuli& m, const PrincipalStretch<Dim>& s) {
   if constexpr (Dim == 2) {
-    const Vec<2> t = principal_kirchhoff<2>(m, s.eps);
-    const double ux = s.U(0, 1), uy = s.U(1, 1);
-    const double dt = t[1] - t[0];
-    const double off = dt * ux * uy;
     Mat<2> tau;
-    tau(0, 0) = t[0] + dt * ux * ux;
-    tau(1, 1) = t[0] + dt * uy * uy;
-    tau(0, 1) = off;
-    tau(1, 0) = off;
+    kirchhoff_stress_2d(m, s.eps[0], s.eps[1], s.U(0, 1), s.U(1, 1), tau(0, 0), tau(1, 1), tau(0, 1));
+    tau(1, 0) = tau(0, 1);
     return tau;
   } else {
     return s.U * principal_kirchhoff<Dim>(m, s.eps).asDiagonal() * s.U.transpose();

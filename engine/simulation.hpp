@@ -114,6 +114,9 @@ class Simulation {
   bool averaging_weights_damage() const;  // the averaging weights each particle by 1 − D
   template <bool Plastic>
   void update_all_particles();
+  // 2D: the same update over a block of particles at a time (simulation.cpp).
+  template <bool Plastic>
+  void update_particles_2d(std::size_t begin, std::size_t end, bool damage, bool plastic);
   template <bool Plastic>
   void finish_step();
   void project_particles_out_of_bed();

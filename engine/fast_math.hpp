@@ -1,0 +1,35 @@
+#pragma once
+// Cheaper forms of libm calls that return the very same double as the call they replace, so the
+// engine's results stay bit for bit what they were (tests/engine/test_fast_math.cpp,
+// bench/state_hash).
+#include <bit>
+#include <cmath>
+#include <cstdint>
+
+namespace crevasse {
+
+// pow(x, 0.5) as glibc's pow returns it, mostly at the price of a square root.
+//
+// sqrt is correctly rounded; glibc's pow (the Arm optimized-routines pow of glibc ≥ 2.28) is not,
+// but its documented worst-case error is 0.54 ULP (glibc sysdeps/ieee754/dbl-64/e_pow.c). So
+// when the exact root √x lies within 0.42 of a gap of s = sqrt(x), every other double is at
+// least 0.58 gaps from √x and pow can only return s. Where √x lies is found from the exact
+// residual x − s² (Dekker's product s² = p + e, with Veltkamp's split; no FMA): √x − s ≈
+// (x − s²)/(2s). Otherwise (about 16 % of arguments, those near a rounding midpoint, and any x
+// outside [2^-500, 2^500] or not a number) pow itself is called.
+inline double pow_half(double x) {
+  if (!(x >= 0x1p-500 && x <= 0x1p500)) return std::pow(x, 0.5);
+  const double s = std::sqrt(x);
+  const double split = 134217729.0 * s;  // 2^27 + 1
+  const double hi = split - (split - s), lo = s - hi;
+  const double p = s * s;
+  const double e = ((hi * hi - p) + 2.0 * hi * lo) + lo * lo;  // s² − p, exactly
+  const double residual = (x - p) - e;                         // x − s²; x − p is exact (Sterbenz)
+  // The gap to the next double below s: the smaller of its two gaps (they differ only when s is
+  // a power of two), so the test is conservative on both sides.
+  const double gap = s - std::bit_cast<double>(std::bit_cast<std::uint64_t>(s) - 1);
+  if (std::abs(residual) <= 2.0 * 0.42 * s * gap) return s;
+  return std::pow(x, 0.5);
+}
+
+}  // namespace crevasse
