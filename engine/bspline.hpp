@@ -14,34 +14,43 @@ struct QuadraticWeights1d {
   std::array<double, 3> w{};
 };
 
+// Writes the three weights of xi into w and returns the base node.
+inline int quadratic_weights_into(double xi, double* w) {
+  const int base = static_cast<int>(std::floor(xi - 0.5));
+  const double fx = xi - base;  // in [0.5, 1.5)
+  w[0] = 0.5 * (1.5 - fx) * (1.5 - fx);
+  w[1] = 0.75 - (fx - 1.0) * (fx - 1.0);
+  w[2] = 0.5 * (fx - 0.5) * (fx - 0.5);
+  return base;
+}
+
 inline QuadraticWeights1d quadratic_weights(double xi) {
   QuadraticWeights1d out;
-  out.base = static_cast<int>(std::floor(xi - 0.5));
-  const double fx = xi - out.base;  // in [0.5, 1.5)
-  out.w[0] = 0.5 * (1.5 - fx) * (1.5 - fx);
-  out.w[1] = 0.75 - (fx - 1.0) * (fx - 1.0);
-  out.w[2] = 0.5 * (fx - 0.5) * (fx - 0.5);
+  out.base = quadratic_weights_into(xi, out.w.data());
   return out;
 }
 
 // Per-axis weights of one particle, and the tensor-product weight of one of its 3^Dim nodes.
+// Plain arrays filled in place: a struct of structs built from returned temporaries went
+// through the stack and stalled on store-to-load forwarding in every sweep (docs/performance.md).
 template <int Dim>
 struct StencilWeights {
-  std::array<QuadraticWeights1d, Dim> axis;
+  int b[Dim];
+  double w[Dim][3];
 
   explicit StencilWeights(const Vec<Dim>& x_over_dx) {
-    for (int a = 0; a < Dim; ++a) axis[a] = quadratic_weights(x_over_dx[a]);
+    for (int a = 0; a < Dim; ++a) b[a] = quadratic_weights_into(x_over_dx[a], w[a]);
   }
   IVec<Dim> base() const {
-    IVec<Dim> b;
-    for (int a = 0; a < Dim; ++a) b[a] = axis[a].base;
-    return b;
+    IVec<Dim> out;
+    for (int a = 0; a < Dim; ++a) out[a] = b[a];
+    return out;
   }
   // offset: each component in {0,1,2}
   double weight(const IVec<Dim>& offset) const {
-    double w = 1.0;
-    for (int a = 0; a < Dim; ++a) w *= axis[a].w[offset[a]];
-    return w;
+    double wt = 1.0;
+    for (int a = 0; a < Dim; ++a) wt *= w[a][offset[a]];
+    return wt;
   }
 };
 
@@ -50,12 +59,12 @@ template <int Dim, class F>
 inline void for_each_stencil_node(const StencilWeights<Dim>& s, F&& f) {
   if constexpr (Dim == 2) {
     for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) f(IVec<2>(i, j), s.axis[0].w[i] * s.axis[1].w[j]);
+      for (int j = 0; j < 3; ++j) f(IVec<2>(i, j), s.w[0][i] * s.w[1][j]);
   } else {
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j)
         for (int k = 0; k < 3; ++k)
-          f(IVec<3>(i, j, k), s.axis[0].w[i] * s.axis[1].w[j] * s.axis[2].w[k]);
+          f(IVec<3>(i, j, k), s.w[0][i] * s.w[1][j] * s.w[2][k]);
   }
 }
 

@@ -183,16 +183,42 @@ void Simulation<Dim>::build_bed_table() {
       bed_normal_[f] = bed_->normal(x, z);
     }
   });
+  // Per column of cells, the lowest cell row from which every cell up to the table's top has
+  // four corners with φ ≥ 0 (bed_nk_ − 1 when the top cell has not).
+  bed_clear_k_.assign(static_cast<std::size_t>(bed_ni_ - 1), bed_nk_ - 1);
+  const auto at = [&](int i, int k) { return bed_phi_[static_cast<std::size_t>(i) * bed_nk_ + k]; };
+  for (int i = 0; i + 1 < bed_ni_; ++i) {
+    for (int k = bed_nk_ - 2; k >= 0; --k) {
+      if (!(at(i, k) >= 0.0 && at(i, k + 1) >= 0.0 && at(i + 1, k) >= 0.0 && at(i + 1, k + 1) >= 0.0))
+        break;
+      bed_clear_k_[static_cast<std::size_t>(i)] = k;
+    }
+  }
+}
+
+template <int Dim>
+typename Simulation<Dim>::BedCell Simulation<Dim>::bed_cell(const Vec<Dim>& x) const {
+  // The table cell of x and x's place in it, clamped to the table.
+  const double dx = scene_.dx;
+  const double gx = x[0] / dx - bed_i0_, gz = x[up_axis<Dim>] / dx - bed_k0_;
+  BedCell c;
+  c.i = std::clamp(static_cast<int>(std::floor(gx)), 0, bed_ni_ - 2);
+  c.k = std::clamp(static_cast<int>(std::floor(gz)), 0, bed_nk_ - 2);
+  c.fx = std::clamp(gx - c.i, 0.0, 1.0);
+  c.fz = std::clamp(gz - c.k, 0.0, 1.0);
+  return c;
 }
 
 template <int Dim>
 double Simulation<Dim>::bed_phi(const Vec<Dim>& x, Vec<Dim>* normal) const {
+  return bed_phi(bed_cell(x), normal);
+}
+
+template <int Dim>
+double Simulation<Dim>::bed_phi(const BedCell& cell, Vec<Dim>* normal) const {
   // Bilinear interpolation of the node table in (x, z).
-  const double dx = scene_.dx;
-  const double gx = x[0] / dx - bed_i0_, gz = x[up_axis<Dim>] / dx - bed_k0_;
-  const int i = std::clamp(static_cast<int>(std::floor(gx)), 0, bed_ni_ - 2);
-  const int k = std::clamp(static_cast<int>(std::floor(gz)), 0, bed_nk_ - 2);
-  const double fx = std::clamp(gx - i, 0.0, 1.0), fz = std::clamp(gz - k, 0.0, 1.0);
+  const int i = cell.i, k = cell.k;
+  const double fx = cell.fx, fz = cell.fz;
   const double w[4] = {(1 - fx) * (1 - fz), (1 - fx) * fz, fx * (1 - fz), fx * fz};
   const std::size_t f[4] = {static_cast<std::size_t>(i) * bed_nk_ + k,
                             static_cast<std::size_t>(i) * bed_nk_ + k + 1,
@@ -845,17 +871,24 @@ void Simulation<Dim>::finish_step() {
 
 template <int Dim>
 void Simulation<Dim>::project_particles_out_of_bed() {
-  auto& P = particles_;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, P.size(), kGrain), [&](const auto& r) {
-    for (std::size_t p = r.begin(); p != r.end(); ++p) {
-      // The normal (two more interpolations and a hypot) only for the few particles inside.
-      const double phi = bed_phi(P.x[p], nullptr);
-      if (phi >= 0.0) continue;
-      Vec<Dim> n;
-      bed_phi(P.x[p], &n);
-      P.x[p] -= phi * n;
-    }
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, particles_.size(), kGrain), [&](const auto& r) {
+    for (std::size_t p = r.begin(); p != r.end(); ++p) project_out_of_bed(p);
   });
+}
+
+template <int Dim>
+[[gnu::always_inline]] inline void Simulation<Dim>::project_out_of_bed(std::size_t p) {
+  auto& x = particles_.x[p];
+  const BedCell cell = bed_cell(x);
+  // A cell whose four corners have φ ≥ 0 interpolates φ ≥ 0 (non-negative weights): nothing to
+  // do, and nothing to interpolate, for most of the ice.
+  if (cell.k >= bed_clear_k_[static_cast<std::size_t>(cell.i)]) return;
+  // The normal (two more interpolations and a hypot) only for the few particles inside.
+  const double phi = bed_phi(cell, nullptr);
+  if (phi >= 0.0) return;
+  Vec<Dim> n;
+  bed_phi(cell, &n);
+  x -= phi * n;
 }
 
 template <int Dim>

@@ -127,6 +127,13 @@ class Simulation {
   void update_time_step();
 
   double bed_phi(const Vec<Dim>& x, Vec<Dim>* normal) const;
+  struct BedCell {
+    int i, k;       // the bed table's cell
+    double fx, fz;  // place in it, in [0, 1]
+  };
+  BedCell bed_cell(const Vec<Dim>& x) const;
+  double bed_phi(const BedCell& cell, Vec<Dim>* normal) const;
+  void project_out_of_bed(std::size_t p);  // one particle of project_particles_out_of_bed
 
   SceneConfig scene_;
   ElasticModuli moduli_;
@@ -137,6 +144,7 @@ class Simulation {
   // Bed signed distance and normal on the lattice nodes of the domain, indexed (x, z).
   std::vector<double> bed_phi_;
   std::vector<std::array<double, 2>> bed_normal_;
+  std::vector<int> bed_clear_k_;  // per cell column: from this cell row up, φ ≥ 0 at every corner
   int bed_i0_ = 0, bed_k0_ = 0, bed_ni_ = 0, bed_nk_ = 0;
 
   std::vector<Stage> stage_fns_;
