@@ -17,9 +17,10 @@ namespace crevasse {
 // residual x − s² (Dekker's product s² = p + e, with Veltkamp's split; no FMA): √x − s ≈
 // (x − s²)/(2s). Otherwise (about 16 % of arguments, those near a rounding midpoint, and any x
 // outside [2^-500, 2^500] or not a number) pow itself is called.
-inline double pow_half(double x) {
-  if (!(x >= 0x1p-500 && x <= 0x1p500)) return std::pow(x, 0.5);
-  const double s = std::sqrt(x);
+// Whether s = sqrt(x) is what pow(x, 0.5) returns, by the test above; no branch, so a loop of
+// it vectorises. False for x outside [2^-500, 2^500] (Veltkamp's split would overflow or lose
+// bits there) and for NaN.
+inline bool sqrt_is_pow_half(double x, double s) {
   const double split = 134217729.0 * s;  // 2^27 + 1
   const double hi = split - (split - s), lo = s - hi;
   const double p = s * s;
@@ -28,8 +29,13 @@ inline double pow_half(double x) {
   // The gap to the next double below s: the smaller of its two gaps (they differ only when s is
   // a power of two), so the test is conservative on both sides.
   const double gap = s - std::bit_cast<double>(std::bit_cast<std::uint64_t>(s) - 1);
-  if (std::abs(residual) <= 2.0 * 0.42 * s * gap) return s;
-  return std::pow(x, 0.5);
+  const bool in_range = x >= 0x1p-500 && x <= 0x1p500;
+  return in_range & (std::abs(residual) <= 2.0 * 0.42 * s * gap);
+}
+
+inline double pow_half(double x) {
+  const double s = std::sqrt(x);
+  return sqrt_is_pow_half(x, s) ? s : std::pow(x, 0.5);
 }
 
 }  // namespace crevasse

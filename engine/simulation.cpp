@@ -194,6 +194,18 @@ void Simulation<Dim>::build_bed_table() {
       bed_clear_k_[static_cast<std::size_t>(i)] = k;
     }
   }
+  // The same as a height, safe for the column found from x·(1/dx) instead of x/dx (the two
+  // may round to neighbouring columns): the highest clear row of this and the two neighbouring
+  // columns, one cell higher still; never, when one of them has no clear cell at all (the
+  // clamp to the table's top row would then land in a cell that is not clear).
+  bed_inv_dx_ = 1.0 / dx;
+  bed_clear_z_.assign(bed_clear_k_.size(), std::numeric_limits<double>::infinity());
+  for (int i = 0; i + 1 < bed_ni_; ++i) {
+    int k = 0;
+    for (int j = std::max(0, i - 1); j <= std::min(bed_ni_ - 2, i + 1); ++j)
+      k = std::max(k, bed_clear_k_[static_cast<std::size_t>(j)]);
+    if (k <= bed_nk_ - 2) bed_clear_z_[static_cast<std::size_t>(i)] = (bed_k0_ + k + 2) * dx;
+  }
 }
 
 template <int Dim>
@@ -740,20 +752,35 @@ void Simulation<Dim>::normalise_volume_average() {
 }
 
 template <int Dim>
-[[gnu::always_inline]] inline double Simulation<Dim>::averaged_volume_scale(std::size_t p, const StencilWeights<Dim>& w,
-                                              double intact) const {
-  // ΔJ_used/ΔJ_p of particle p (before its update moves it), from the normalised grid_aux_.
-  const auto& P = particles_;
+[[gnu::always_inline]] inline typename Simulation<Dim>::VolumeSums Simulation<Dim>::volume_sums(
+    std::size_t p, const StencilWeights<Dim>& w) const {
+  // The stencil's Σ w ΔJ̄ and Σ w over the nodes that carry an average, from the normalised
+  // grid_aux_, and ΔJ_p of particle p (before its update moves it).
   const IVec<Dim> base = w.base();
-  double jbar = 0.0, wsum = 0.0;
+  VolumeSums v{0.0, 0.0, 0.0};
   for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
     const std::size_t f = 2 * grid_.flat(base + off);
-    jbar += wt * grid_aux_[f];
-    wsum += wt * grid_aux_[f + 1];
+    v.jbar += wt * grid_aux_[f];
+    v.wsum += wt * grid_aux_[f + 1];
   });
-  const double dj = (Mat<Dim>::Identity() + dt_ * P.C[p]).determinant();
-  const double used = wsum > 0.0 ? intact * (jbar / wsum) + (1.0 - intact) * dj : dj;
-  return (dj > 0.0 && used > 0.0) ? used / dj : 1.0;
+  v.dj = (Mat<Dim>::Identity() + dt_ * particles_.C[p]).determinant();
+  return v;
+}
+
+// ΔJ_used/ΔJ_p, with `intact` = 1 − D the particle's share of the average. Selects, no branch
+// (a lane's unused quotient may be inf or NaN; it is never selected).
+inline double volume_scale_of(double jbar, double wsum, double dj, double intact) {
+  const double averaged = intact * (jbar / wsum) + (1.0 - intact) * dj;
+  const double used = wsum > 0.0 ? averaged : dj;
+  const double ratio = used / dj;
+  return (dj > 0.0 && used > 0.0) ? ratio : 1.0;
+}
+
+template <int Dim>
+[[gnu::always_inline]] inline double Simulation<Dim>::averaged_volume_scale(std::size_t p, const StencilWeights<Dim>& w,
+                                              double intact) const {
+  const VolumeSums v = volume_sums(p, w);
+  return volume_scale_of(v.jbar, v.wsum, v.dj, intact);
 }
 
 template <int Dim>
@@ -795,7 +822,8 @@ void Simulation<Dim>::update_particles_2d(std::size_t begin, std::size_t end, bo
   const double dt = dt_;
   const ElasticModuli moduli = moduli_;
   const CappedVonMisesParams plastic_params = plastic_;
-  double vs[kBlock], scale[kBlock], soft[kBlock];
+  double jbar[kBlock], wsum[kBlock], dj[kBlock], vs[kBlock], scale[kBlock], soft[kBlock];
+  std::int64_t need_pow[kBlock];
   double f00[kBlock], f01[kBlock], f10[kBlock], f11[kBlock];
   double m[kBlock], h[kBlock], d[kBlock], r[kBlock], jm1[kBlock], e0[kBlock], e1[kBlock];
   double t00[kBlock], t11[kBlock], t01[kBlock];
@@ -804,12 +832,24 @@ void Simulation<Dim>::update_particles_2d(std::size_t begin, std::size_t end, bo
     const std::size_t n = std::min(kBlock, end - b);
     for (std::size_t i = 0; i < n; ++i) {
       const std::size_t p = b + i;
-      const StencilWeights<2> w(Vec<2>(P.x[p] * inv_dx));
+      const VolumeSums v = volume_sums(p, StencilWeights<2>(Vec<2>(P.x[p] * inv_dx)));
+      jbar[i] = v.jbar;
+      wsum[i] = v.wsum;
+      dj[i] = v.dj;
       soft[i] = plastic ? softening_[p] : 1.0;
-      vs[i] = averaged_volume_scale(p, w, damage ? soft[i] : 1.0);
-      // ΔF·s with s = 1 is exact, so the unscaled particles need no branch below.
-      scale[i] = vs[i] != 1.0 ? volume_root<2>(vs[i]) : 1.0;
     }
+    // The volume ratio and its root (pow_half split in two: the square root and its test over
+    // the block, pow one by one where the test fails). ΔF·s with s = 1 is exact, so the
+    // unscaled particles need no branch below.
+    for (std::size_t i = 0; i < n; ++i) {
+      vs[i] = volume_scale_of(jbar[i], wsum[i], dj[i], damage ? soft[i] : 1.0);
+      const double root = std::sqrt(vs[i]);
+      const bool unscaled = vs[i] == 1.0;
+      scale[i] = unscaled ? 1.0 : root;
+      need_pow[i] = !unscaled & !sqrt_is_pow_half(vs[i], root);
+    }
+    for (std::size_t i = 0; i < n; ++i)
+      if (need_pow[i]) scale[i] = std::pow(vs[i], 0.5);
     for (std::size_t i = 0; i < n; ++i) {
       const double* c = P.C[b + i].data();  // column-major: C00, C10, C01, C11
       const double* fe = P.F_e[b + i].data();
@@ -879,6 +919,10 @@ void Simulation<Dim>::project_particles_out_of_bed() {
 template <int Dim>
 [[gnu::always_inline]] inline void Simulation<Dim>::project_out_of_bed(std::size_t p) {
   auto& x = particles_.x[p];
+  // First a test without divisions: above bed_clear_z_ of its column (rounded either way) a
+  // particle's exact cell is clear (below).
+  const int column = std::clamp(static_cast<int>(std::floor(x[0] * bed_inv_dx_)) - bed_i0_, 0, bed_ni_ - 2);
+  if (x[up_axis<Dim>] >= bed_clear_z_[static_cast<std::size_t>(column)]) return;
   const BedCell cell = bed_cell(x);
   // A cell whose four corners have φ ≥ 0 interpolates φ ≥ 0 (non-negative weights): nothing to
   // do, and nothing to interpolate, for most of the ice.

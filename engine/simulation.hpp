@@ -111,6 +111,10 @@ class Simulation {
   void gather_velocities_and_scatter_volume();
   void normalise_volume_average();
   double averaged_volume_scale(std::size_t p, const StencilWeights<Dim>& w, double intact) const;
+  struct VolumeSums {
+    double jbar, wsum, dj;
+  };
+  VolumeSums volume_sums(std::size_t p, const StencilWeights<Dim>& w) const;
   bool averaging_weights_damage() const;  // the averaging weights each particle by 1 − D
   template <bool Plastic>
   void update_all_particles();
@@ -145,6 +149,8 @@ class Simulation {
   std::vector<double> bed_phi_;
   std::vector<std::array<double, 2>> bed_normal_;
   std::vector<int> bed_clear_k_;  // per cell column: from this cell row up, φ ≥ 0 at every corner
+  std::vector<double> bed_clear_z_;  // per cell column: above this z, the particle's cell is clear
+  double bed_inv_dx_ = 1.0;
   int bed_i0_ = 0, bed_k0_ = 0, bed_ni_ = 0, bed_nk_ = 0;
 
   std::vector<Stage> stage_fns_;
