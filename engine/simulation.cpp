@@ -804,13 +804,14 @@ void Simulation<Dim>::update_all_particles() {
 }
 
 // The 2D update of particles [begin, end), a block of kBlock at a time, with the results of
-// update_particle to the bit (bench/state_hash checks it on whole glacier runs): (1) one by one,
-// the stencil gather of ΔJ̄ and the root of the volume ratio; (2) the arithmetic of ΔF·F_E and of
-// the closed-form eigen-solve up to the logarithms' arguments, over the block, where the compiler
-// keeps two particles per vector register; (3) the two logarithms, one by one; (4) the frame,
-// the yield tests and τ over the block; (5) the stores. A particle whose trial state is outside
-// a yield surface (a few at cracks) is left alone in (5) and updated by update_particle, which
-// starts again from its unchanged state.
+// update_particle to the bit (bench/state_hash checks it on whole glacier runs). Per block:
+// (1) one by one, the stencil gather of the ΔJ̄ sums; (2) over the block, the volume ratio and
+// its square root with pow_half's test; (3) pow where that test failed; (4) over the block,
+// ΔF·F_E and the closed-form eigen-solve up to the logarithms' arguments; (5) the two logarithms,
+// one by one; (6) over the block, the frame, τ and the two yield tests; then the stores. The
+// compiler keeps two particles per vector register in (2), (4) and (6). A particle whose trial
+// state is outside a yield surface (a few at cracks) is not stored from the block:
+// update_particle updates it from its unchanged state.
 template <int Dim>
 template <bool Plastic>
 void Simulation<Dim>::update_particles_2d(std::size_t begin, std::size_t end, bool damage,
