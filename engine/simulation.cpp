@@ -791,8 +791,12 @@ void Simulation<Dim>::update_all_particles() {
   const bool plastic = !softening_.empty();
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, particles_.size(), kGrain), [&](const auto& r) {
     if constexpr (Dim == 2) {
-      update_particles_2d<Plastic>(r.begin(), r.end(), damage, plastic);
-    } else {
+      if (!per_particle_update_) {
+        update_particles_2d<Plastic>(r.begin(), r.end(), damage, plastic);
+        return;
+      }
+    }
+    {
       for (std::size_t p = r.begin(); p != r.end(); ++p) {
         const StencilWeights<Dim> w(Vec<Dim>(particles_.x[p] * inv_dx));
         const double f = plastic ? softening_[p] : 1.0;

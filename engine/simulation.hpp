@@ -44,6 +44,9 @@ class Simulation {
   const SceneConfig& scene() const { return scene_; }
   const Particles<Dim>& particles() const { return particles_; }
   Particles<Dim>& mutable_particles() { return particles_; }  // tests and initial conditions
+  // Tests: update 2D particles one at a time (update_particle) instead of in vectorised blocks
+  // (update_particles_2d); the two must agree bit for bit.
+  void set_per_particle_update(bool on) { per_particle_update_ = on; }
   const std::vector<StageStats>& stages() const { return stages_; }
   std::int64_t return_map_evaluations() const { return return_map_evaluations_; }
   std::int64_t particle_steps() const { return particle_steps_; }
@@ -151,6 +154,7 @@ class Simulation {
   std::vector<int> bed_clear_k_;  // per cell column: from this cell row up, φ ≥ 0 at every corner
   std::vector<double> bed_clear_z_;  // per cell column: above this z, the particle's cell is clear
   double bed_inv_dx_ = 1.0;
+  bool per_particle_update_ = false;
   int bed_i0_ = 0, bed_k0_ = 0, bed_ni_ = 0, bed_nk_ = 0;
 
   std::vector<Stage> stage_fns_;
