@@ -24,6 +24,14 @@ void check_range(const std::string& field, double v, double lo, double hi) {
     refuse(field, "value " + fmt(v) + " is outside the allowed range [" + fmt(lo) + ", " + fmt(hi) + "]");
 }
 
+// "[a]": built by appending, because g++ 12 warns falsely (-Wrestrict) on "[" + to_string(a).
+std::string index_suffix(long a) {
+  std::string out = "[";
+  out += std::to_string(a);
+  out += ']';
+  return out;
+}
+
 // A key given with a non-null value (ObjectReader treats null as absent).
 bool given(const nlohmann::json& j, const char* section, const char* key) {
   if (!j.is_object() || !j.contains(section)) return false;
@@ -35,7 +43,7 @@ bool given(const nlohmann::json& j, const char* section, const char* key) {
 
 void check_scene_json(const nlohmann::json& j, const SceneConfig& s) {
   const int z = s.dim - 1;
-  const std::string axis_z = "[" + std::to_string(z) + "]";
+  const std::string axis_z = index_suffix(z);
   // Fields the engine would ignore without a word.
   if (!s.velocity_boxes.empty() && !s.has(Effect::velocity_boundaries))
     refuse("velocity_boxes", std::to_string(s.velocity_boxes.size()) +
@@ -77,7 +85,7 @@ void check_scene_json(const nlohmann::json& j, const SceneConfig& s) {
     const auto& b = s.velocity_boxes[i];
     const std::string f = "velocity_boxes[" + std::to_string(i) + "].";
     for (int a = 0; a < s.dim; ++a) {
-      const std::string ax = "[" + std::to_string(a) + "]";
+      const std::string ax = index_suffix(a);
       check_range(f + "min" + ax, b.min[a], -reach, reach);
       check_range(f + "max" + ax, b.max[a], -reach, reach);
       check_range(f + "velocity" + ax, b.velocity[a], -1e3, 1e3);
