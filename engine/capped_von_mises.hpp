@@ -48,6 +48,16 @@ inline double shear_strength(const CappedVonMisesParams& p, double eps_v_p, doub
   return shear_strength_softened(p, softening_factor(p, eps_v_p), pressure);
 }
 
+// The two yield tests of a trial state, shared by the return mapping below and the engine's 2D
+// block update (admissible_2d), so both decide with the same operations.
+inline bool cap_violated(double p_trial, const CappedVonMisesParams& p, double softening) {
+  return p_trial < -p.tensile_strength_c * softening;
+}
+// q = sqrt(3/2)·2μ‖dev ε‖ from ‖dev ε‖.
+inline double von_mises_of_strain_deviator(const ElasticModuli& m, double dev_norm) {
+  return std::sqrt(6.0) * m.mu * dev_norm;
+}
+
 template <int Dim>
 struct ReturnResult {
   Vec<Dim> eps;            // returned principal Hencky strains
@@ -102,7 +112,7 @@ inline ReturnResult<Dim> return_map_capped_von_mises(const Vec<Dim>& eps_trial, 
   const double k = m.bulk(Dim);
   const double tr = eps_trial.sum();
   const double p_trial = -k * tr;
-  if (p_trial < -p.tensile_strength_c * softening) {
+  if (cap_violated(p_trial, p, softening)) {
     const double delta = cap_return_increment(p_trial, k, eps_v_p, p);
     r.eps.array() -= delta / Dim;
     r.delta_eps_v = delta;
@@ -110,7 +120,7 @@ inline ReturnResult<Dim> return_map_capped_von_mises(const Vec<Dim>& eps_trial, 
   }
   const double tr_new = r.eps.sum();
   Vec<Dim> dev = r.eps.array() - tr_new / Dim;
-  const double q_trial = std::sqrt(6.0) * m.mu * dev.norm();  // q = sqrt(3/2)·2μ‖dev ε‖
+  const double q_trial = von_mises_of_strain_deviator(m, dev.norm());
   const double q_y = r.cap_active ? shear_strength(p, eps_v_p + r.delta_eps_v, -k * tr_new)
                                   : shear_strength_softened(p, softening, -k * tr_new);
   if (q_trial > q_y) {
@@ -121,21 +131,20 @@ inline ReturnResult<Dim> return_map_capped_von_mises(const Vec<Dim>& eps_trial, 
   return r;
 }
 
-// Whether the 2D trial state (principal strains e0, e1) lies inside both surfaces, by the very
-// tests of return_map_capped_von_mises<2> (same operations): the engine's 2D block update keeps
+// Whether the 2D trial state (principal strains e0, e1) lies inside both surfaces, by the tests
+// of return_map_capped_von_mises<2> (cap_violated, von_mises_of_strain_deviator,
+// shear_strength_softened, on the same trace and deviator): the engine's 2D block update keeps
 // such a particle's trial state and sends the others through the return mapping above. Written
 // without branches, so that it vectorises over a block.
 inline bool admissible_2d(double e0, double e1, const ElasticModuli& m, const CappedVonMisesParams& p,
                           double softening) {
   const double k = m.bulk(2);
   const double tr = e0 + e1;
-  const double p_trial = -k * tr;
-  const bool cap = p_trial < -p.tensile_strength_c * softening;
   const double half = tr / 2;
   const double d0 = e0 - half, d1 = e1 - half;
-  const double q_trial = std::sqrt(6.0) * m.mu * std::sqrt(d0 * d0 + d1 * d1);
+  const double q_trial = von_mises_of_strain_deviator(m, std::sqrt(d0 * d0 + d1 * d1));
   const double q_y = shear_strength_softened(p, softening, -k * tr);
-  return !cap & !(q_trial > q_y);
+  return !cap_violated(-k * tr, p, softening) & !(q_trial > q_y);
 }
 
 template <int Dim>

@@ -796,12 +796,10 @@ void Simulation<Dim>::update_all_particles() {
         return;
       }
     }
-    {
-      for (std::size_t p = r.begin(); p != r.end(); ++p) {
-        const StencilWeights<Dim> w(Vec<Dim>(particles_.x[p] * inv_dx));
-        const double f = plastic ? softening_[p] : 1.0;
-        update_particle<Plastic>(p, averaged_volume_scale(p, w, damage ? f : 1.0), f);
-      }
+    for (std::size_t p = r.begin(); p != r.end(); ++p) {
+      const StencilWeights<Dim> w(Vec<Dim>(particles_.x[p] * inv_dx));
+      const double f = plastic ? softening_[p] : 1.0;
+      update_particle<Plastic>(p, averaged_volume_scale(p, w, damage ? f : 1.0), f);
     }
   });
   finish_step<Plastic>();

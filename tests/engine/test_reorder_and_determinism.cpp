@@ -111,6 +111,18 @@ bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
   return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
 }
 
+// Every array of the step's state equal, bit for bit.
+template <int Dim>
+void expect_same_state(const Particles<Dim>& a, const Particles<Dim>& b) {
+  EXPECT_GT(a.size(), 0u);
+  EXPECT_TRUE(same_bits(a.x, b.x));
+  EXPECT_TRUE(same_bits(a.v, b.v));
+  EXPECT_TRUE(same_bits(a.C, b.C));
+  EXPECT_TRUE(same_bits(a.F_e, b.F_e));
+  EXPECT_TRUE(same_bits(a.tau, b.tau));
+  EXPECT_TRUE(same_bits(a.eps_v_p, b.eps_v_p));
+}
+
 template <int Dim>
 Particles<Dim> run_with_threads(const SceneConfig& scene, int threads, int steps) {
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
@@ -123,13 +135,7 @@ template <int Dim>
 void expect_thread_count_independent(const SceneConfig& scene, int steps) {
   const Particles<Dim> one = run_with_threads<Dim>(scene, 1, steps);
   const Particles<Dim> two = run_with_threads<Dim>(scene, 2, steps);
-  ASSERT_GT(one.size(), 0u);
-  EXPECT_TRUE(same_bits(one.x, two.x));
-  EXPECT_TRUE(same_bits(one.v, two.v));
-  EXPECT_TRUE(same_bits(one.C, two.C));
-  EXPECT_TRUE(same_bits(one.F_e, two.F_e));
-  EXPECT_TRUE(same_bits(one.tau, two.tau));
-  EXPECT_TRUE(same_bits(one.eps_v_p, two.eps_v_p));
+  expect_same_state(one, two);
   // The run must have broken ice, or the return mapping's branches were never compared.
   EXPECT_GT(std::count_if(one.eps_v_p.begin(), one.eps_v_p.end(), [](double e) { return e > 0.0; }), 0);
 }
@@ -162,16 +168,8 @@ Particles<2> expect_block_update_matches_per_particle(const SceneConfig& scene, 
     block.step();
     single.step();
   }
-  const Particles<2>& a = block.particles();
-  const Particles<2>& b = single.particles();
-  EXPECT_GT(a.size(), 0u);
-  EXPECT_TRUE(same_bits(a.x, b.x));
-  EXPECT_TRUE(same_bits(a.v, b.v));
-  EXPECT_TRUE(same_bits(a.C, b.C));
-  EXPECT_TRUE(same_bits(a.F_e, b.F_e));
-  EXPECT_TRUE(same_bits(a.tau, b.tau));
-  EXPECT_TRUE(same_bits(a.eps_v_p, b.eps_v_p));
-  return a;
+  expect_same_state(block.particles(), single.particles());
+  return block.particles();
 }
 
 TEST(BlockUpdate, TwoDimensionalGlacierGivesTheParticleByParticleBits) {
