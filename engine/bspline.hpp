@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 
+#include "engine/fast_math.hpp"
 #include "engine/types.hpp"
 
 namespace crevasse {
@@ -16,7 +17,7 @@ struct QuadraticWeights1d {
 
 // Writes the three weights of xi into w and returns the base node.
 inline int quadratic_weights_into(double xi, double* w) {
-  const int base = static_cast<int>(std::floor(xi - 0.5));
+  const int base = floor_to_int(xi - 0.5);
   const double fx = xi - base;  // in [0.5, 1.5)
   w[0] = 0.5 * (1.5 - fx) * (1.5 - fx);
   w[1] = 0.75 - (fx - 1.0) * (fx - 1.0);

@@ -214,8 +214,8 @@ typename Simulation<Dim>::BedCell Simulation<Dim>::bed_cell(const Vec<Dim>& x) c
   const double dx = scene_.dx;
   const double gx = x[0] / dx - bed_i0_, gz = x[up_axis<Dim>] / dx - bed_k0_;
   BedCell c;
-  c.i = std::clamp(static_cast<int>(std::floor(gx)), 0, bed_ni_ - 2);
-  c.k = std::clamp(static_cast<int>(std::floor(gz)), 0, bed_nk_ - 2);
+  c.i = std::clamp(floor_to_int(gx), 0, bed_ni_ - 2);
+  c.k = std::clamp(floor_to_int(gz), 0, bed_nk_ - 2);
   c.fx = std::clamp(gx - c.i, 0.0, 1.0);
   c.fz = std::clamp(gz - c.k, 0.0, 1.0);
   return c;
@@ -393,7 +393,7 @@ void Simulation<Dim>::prepare_grid() {
         for (std::size_t p = r.begin(); p != r.end(); ++p) {
           std::uint64_t k = 0;
           for (int a = 0; a < Dim; ++a)
-            k = (k << 20) | static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(P.x[p][a] * inv_dx)) + (1 << 19));
+            k = (k << 20) | static_cast<std::uint64_t>(static_cast<std::int64_t>(floor_to_int(P.x[p][a] * inv_dx)) + (1 << 19));
           key[p] = k;
         }
       });
@@ -410,7 +410,7 @@ void Simulation<Dim>::prepare_grid() {
       [&](const auto& r, Range acc) {
         for (std::size_t p = r.begin(); p != r.end(); ++p) {
           for (int a = 0; a < Dim; ++a) {
-            const int b = static_cast<int>(std::floor(P.x[p][a] * inv_dx - 0.5));
+            const int b = floor_to_int(P.x[p][a] * inv_dx - 0.5);
             acc.first[a] = std::min(acc.first[a], b);
             acc.second[a] = std::max(acc.second[a], b + 2);
           }
@@ -433,7 +433,7 @@ void Simulation<Dim>::prepare_grid() {
   const std::size_t block_size = (n + blocks - 1) / blocks;
   const int lo_x = grid_.lo[0];
   const auto slab_of = [&](std::size_t p) {
-    const int b = static_cast<int>(std::floor(P.x[p][0] * inv_dx - 0.5)) - lo_x;
+    const int b = floor_to_int(P.x[p][0] * inv_dx - 0.5) - lo_x;
     return static_cast<std::size_t>(b / kSlabCells);
   };
   auto& offsets = slab_block_offsets_;  // [block][slab]
@@ -924,7 +924,7 @@ template <int Dim>
   auto& x = particles_.x[p];
   // First a test without divisions: above bed_clear_z_ of its column (rounded either way) a
   // particle's exact cell is clear (below).
-  const int column = std::clamp(static_cast<int>(std::floor(x[0] * bed_inv_dx_)) - bed_i0_, 0, bed_ni_ - 2);
+  const int column = std::clamp(floor_to_int(x[0] * bed_inv_dx_) - bed_i0_, 0, bed_ni_ - 2);
   if (x[up_axis<Dim>] >= bed_clear_z_[static_cast<std::size_t>(column)]) return;
   const BedCell cell = bed_cell(x);
   // A cell whose four corners have φ ≥ 0 interpolates φ ≥ 0 (non-negative weights): nothing to

@@ -55,5 +55,31 @@ TEST(PowHalf, SameBitsAsPowOverTheWholeRange) {
     EXPECT_TRUE(same_bits(x));
 }
 
+// floor_to_int is (int)std::floor over the range the stencils use: the integers themselves, their
+// neighbours on both sides of zero, the halves (where xi − 0.5 of a stencil lands on an integer)
+// and random values. A version that forgets the correction for negative numbers fails on −0.5.
+TEST(FloorToInt, SameIntegerAsFloor) {
+  const auto check = [](double t) {
+    ASSERT_EQ(floor_to_int(t), static_cast<int>(std::floor(t))) << t;
+  };
+  for (int k = -100000; k <= 100000; ++k) {
+    const double t = k;
+    check(t);
+    check(std::nextafter(t, -1e9));
+    check(std::nextafter(t, 1e9));
+    check(t + 0.5);
+    check(-(t + 0.5));
+  }
+  check(0.0);
+  check(-0.0);
+  check(std::numeric_limits<double>::denorm_min());
+  check(-std::numeric_limits<double>::denorm_min());
+  check(2147483647.0);
+  check(-2147483648.0);
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1e6, 1e6);
+  for (int i = 0; i < 1000000; ++i) check(u(rng));
+}
+
 }  // namespace
 }  // namespace crevasse
