@@ -137,11 +137,11 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   } else {
     add_stage("g2p_elastic", [this] { grid_to_particle<false>(); });
   }
-  if (scene_.has(Effect::basal_friction))
-    add_stage("bed_projection", [this] { project_particles_out_of_bed(); });
-  if (scene_.has(Effect::drive)) add_stage("drive", [this] { drive_back_layer(); });
+  // Applied by the update sweep to each particle as it is written (finish_particle).
+  if (scene_.has(Effect::basal_friction)) particle_effects_.push_back("bed_projection");
+  if (scene_.has(Effect::drive)) particle_effects_.push_back("drive");
   // Particles never leave the domain: the last line of defence, whatever the effects.
-  add_stage("domain_clamp", [this] { clamp_particles(domain_lo_, domain_hi_); });
+  particle_effects_.push_back("domain_clamp");
   if (scene_.records_gate()) add_stage("gate", [this] { record_gate(); });
   if (scene_.has(Effect::outflow)) add_stage("outflow", [this] { remove_outflow(); });
   add_stage("time_step", [this] { update_time_step(); });
@@ -537,25 +537,6 @@ void Simulation<Dim>::drive_grid_nodes() {
 }
 
 template <int Dim>
-void Simulation<Dim>::drive_back_layer() {
-  // The piston is the back layer of ice (one cell thick), moved kinematically along x at the
-  // drive speed and free to slide vertically. A grid-node wall instead gives the ice an impulse
-  // each time its face crosses a node column, which builds a grid-scale stress oscillation
-  // behind the face (seen as tensile bands that crack the back of the slab).
-  auto& P = particles_;
-  const double shift = settling_ ? 0.0 : scene_.drive_position(time_);
-  const double v = settling_ ? 0.0 : scene_.drive_velocity(time_);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, P.size(), kGrain), [&](const auto& r) {
-    for (std::size_t p = r.begin(); p != r.end(); ++p) {
-      if (std::isnan(P.drive_x0[p])) continue;
-      P.x[p][0] = P.drive_x0[p] + shift;
-      P.v[p][0] = v;
-      P.C[p].row(0).setZero();
-    }
-  });
-}
-
-template <int Dim>
 void Simulation<Dim>::apply_bed_friction_to_grid() {
   // Coulomb contact with the static bed on nodes inside or on it: remove the approaching normal
   // velocity v_n < 0 and reduce the tangential velocity by μ|v_n| (stick if it would reverse).
@@ -677,17 +658,55 @@ void Simulation<Dim>::update_particle(std::size_t p, double volume_scale, double
 }
 
 template <int Dim>
+typename Simulation<Dim>::ParticleTail Simulation<Dim>::particle_tail() const {
+  ParticleTail t;
+  t.bed = scene_.has(Effect::basal_friction);
+  t.drive = scene_.has(Effect::drive);
+  if (t.drive && !settling_) {
+    // The piston's place at the end of this step: finish_step's time_ + dt_.
+    const double end_time = time_ + dt_;
+    t.drive_shift = scene_.drive_position(end_time);
+    t.drive_v = scene_.drive_velocity(end_time);
+  }
+  return t;
+}
+
+template <int Dim>
+[[gnu::always_inline]] inline void Simulation<Dim>::finish_particle(std::size_t p, const ParticleTail& tail,
+                                                                    StepSummary& acc) {
+  auto& P = particles_;
+  if (tail.bed) project_out_of_bed(p);
+  if (tail.drive && !std::isnan(P.drive_x0[p])) {
+    // The piston is the back layer of ice (one cell thick), moved kinematically along x at the
+    // drive speed and free to slide vertically. A grid-node wall instead gives the ice an
+    // impulse each time its face crosses a node column, which builds a grid-scale stress
+    // oscillation behind the face (seen as tensile bands that crack the back of the slab).
+    P.x[p][0] = P.drive_x0[p] + tail.drive_shift;
+    P.v[p][0] = tail.drive_v;
+    P.C[p].row(0).setZero();
+  }
+  for (int a = 0; a < Dim; ++a) P.x[p][a] = std::clamp(P.x[p][a], domain_lo_[a], domain_hi_[a]);
+  summarise_particle(p, acc);
+}
+
+template <int Dim>
 template <bool Plastic>
 void Simulation<Dim>::grid_to_particle() {
   auto& P = particles_;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, P.size(), kGrain), [&](const auto& r) {
-    const double inv_dx = 1.0 / scene_.dx;
-    for (std::size_t p = r.begin(); p != r.end(); ++p) {
-      const Vec<Dim> xg = P.x[p] * inv_dx;
-      gather_velocity(p, StencilWeights<Dim>(xg), xg);
-      update_particle<Plastic>(p, 1.0, Plastic ? softening_factor(plastic_, P.eps_v_p[p]) : 1.0);
-    }
-  });
+  const ParticleTail tail = particle_tail();
+  summary_ = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, P.size(), kGrain), StepSummary{},
+      [&](const auto& r, StepSummary acc) {
+        const double inv_dx = 1.0 / scene_.dx;
+        for (std::size_t p = r.begin(); p != r.end(); ++p) {
+          const Vec<Dim> xg = P.x[p] * inv_dx;
+          gather_velocity(p, StencilWeights<Dim>(xg), xg);
+          update_particle<Plastic>(p, 1.0, Plastic ? softening_factor(plastic_, P.eps_v_p[p]) : 1.0);
+          finish_particle(p, tail, acc);
+        }
+        return acc;
+      },
+      merge);
   finish_step<Plastic>();
 }
 
@@ -789,19 +808,25 @@ void Simulation<Dim>::update_all_particles() {
   const double inv_dx = 1.0 / scene_.dx;
   const bool damage = averaging_weights_damage();
   const bool plastic = !softening_.empty();
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, particles_.size(), kGrain), [&](const auto& r) {
-    if constexpr (Dim == 2) {
-      if (!per_particle_update_) {
-        update_particles_2d<Plastic>(r.begin(), r.end(), damage, plastic);
-        return;
-      }
-    }
-    for (std::size_t p = r.begin(); p != r.end(); ++p) {
-      const StencilWeights<Dim> w(Vec<Dim>(particles_.x[p] * inv_dx));
-      const double f = plastic ? softening_[p] : 1.0;
-      update_particle<Plastic>(p, averaged_volume_scale(p, w, damage ? f : 1.0), f);
-    }
-  });
+  const ParticleTail tail = particle_tail();
+  summary_ = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, particles_.size(), kGrain), StepSummary{},
+      [&](const auto& r, StepSummary acc) {
+        if constexpr (Dim == 2) {
+          if (!per_particle_update_) {
+            update_particles_2d<Plastic>(r.begin(), r.end(), damage, plastic, tail, acc);
+            return acc;
+          }
+        }
+        for (std::size_t p = r.begin(); p != r.end(); ++p) {
+          const StencilWeights<Dim> w(Vec<Dim>(particles_.x[p] * inv_dx));
+          const double f = plastic ? softening_[p] : 1.0;
+          update_particle<Plastic>(p, averaged_volume_scale(p, w, damage ? f : 1.0), f);
+          finish_particle(p, tail, acc);
+        }
+        return acc;
+      },
+      merge);
   finish_step<Plastic>();
 }
 
@@ -817,7 +842,8 @@ void Simulation<Dim>::update_all_particles() {
 template <int Dim>
 template <bool Plastic>
 void Simulation<Dim>::update_particles_2d(std::size_t begin, std::size_t end, bool damage,
-                                          bool plastic) {
+                                          bool plastic, const ParticleTail& tail,
+                                          StepSummary& acc) {
   static_assert(Dim == 2);
   constexpr std::size_t kBlock = 32;
   auto& P = particles_;
@@ -885,6 +911,7 @@ void Simulation<Dim>::update_particles_2d(std::size_t begin, std::size_t end, bo
       if constexpr (Plastic) {
         if (!elastic[i]) {
           update_particle<true>(p, vs[i], soft[i]);
+          finish_particle(p, tail, acc);
           continue;
         }
       }
@@ -899,6 +926,7 @@ void Simulation<Dim>::update_particles_2d(std::size_t begin, std::size_t end, bo
       tau(1, 1) = t11[i];
       tau(0, 1) = t01[i];
       tau(1, 0) = t01[i];
+      finish_particle(p, tail, acc);
     }
   }
 }
@@ -910,13 +938,7 @@ void Simulation<Dim>::finish_step() {
   particle_steps_ += static_cast<std::int64_t>(particles_.size());
   time_ += dt_;
   ++steps_;
-}
-
-template <int Dim>
-void Simulation<Dim>::project_particles_out_of_bed() {
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, particles_.size(), kGrain), [&](const auto& r) {
-    for (std::size_t p = r.begin(); p != r.end(); ++p) project_out_of_bed(p);
-  });
+  summary_step_ = steps_;
 }
 
 template <int Dim>
@@ -936,16 +958,6 @@ template <int Dim>
   Vec<Dim> n;
   bed_phi(cell, &n);
   x -= phi * n;
-}
-
-template <int Dim>
-void Simulation<Dim>::clamp_particles(const Vec<Dim>& lo, const Vec<Dim>& hi) {
-  // Every axis in one sweep (the clamps of different axes are independent).
-  auto& P = particles_;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, P.size(), kGrain), [&](const auto& r) {
-    for (std::size_t p = r.begin(); p != r.end(); ++p)
-      for (int a = 0; a < Dim; ++a) P.x[p][a] = std::clamp(P.x[p][a], lo[a], hi[a]);
-  });
 }
 
 template <int Dim>
@@ -972,6 +984,7 @@ void Simulation<Dim>::remove_outflow() {
     }
   }
   removed_mass_ += P.compact(keep);
+  summary_step_ = -1;  // the update's summary counted the removed particles
 }
 
 template <int Dim>
@@ -1006,33 +1019,42 @@ double Simulation<Dim>::gate_passed_length() const {
 }
 
 template <int Dim>
-void Simulation<Dim>::update_time_step() {
+typename Simulation<Dim>::StepSummary Simulation<Dim>::merge(StepSummary a, const StepSummary& b) {
+  a.v2 = std::max(a.v2, b.v2);
+  a.front = std::max(a.front, b.front);
+  if (a.bad < 0 || (b.bad >= 0 && b.bad < a.bad)) a.bad = b.bad;
+  return a;
+}
+
+template <int Dim>
+[[gnu::always_inline]] inline void Simulation<Dim>::summarise_particle(std::size_t p, StepSummary& a) const {
   const auto& P = particles_;
-  struct Acc {
-    double v2 = 0.0;
-    double front = -std::numeric_limits<double>::infinity();
-    std::int64_t bad = -1;  // a particle with a non-finite state
-  };
-  const Acc acc = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, P.size(), kGrain), Acc{},
-      [&](const auto& r, Acc a) {
-        for (std::size_t p = r.begin(); p != r.end(); ++p) {
-          const double v2 = P.v[p].squaredNorm();
-          if (!std::isfinite(v2) || !P.tau[p].allFinite()) {
-            if (a.bad < 0) a.bad = static_cast<std::int64_t>(p);
-            continue;
-          }
-          a.v2 = std::max(a.v2, v2);
-          a.front = std::max(a.front, P.x[p][0]);
-        }
+  const double v2 = P.v[p].squaredNorm();
+  if (!std::isfinite(v2) || !P.tau[p].allFinite()) {
+    if (a.bad < 0) a.bad = static_cast<std::int64_t>(p);
+    return;
+  }
+  a.v2 = std::max(a.v2, v2);
+  a.front = std::max(a.front, P.x[p][0]);
+}
+
+template <int Dim>
+typename Simulation<Dim>::StepSummary Simulation<Dim>::summarise_particles() const {
+  return tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, particles_.size(), kGrain), StepSummary{},
+      [&](const auto& r, StepSummary a) {
+        for (std::size_t p = r.begin(); p != r.end(); ++p) summarise_particle(p, a);
         return a;
       },
-      [](Acc a, const Acc& b) {
-        a.v2 = std::max(a.v2, b.v2);
-        a.front = std::max(a.front, b.front);
-        if (a.bad < 0 || (b.bad >= 0 && b.bad < a.bad)) a.bad = b.bad;
-        return a;
-      });
+      merge);
+}
+
+template <int Dim>
+void Simulation<Dim>::update_time_step() {
+  const auto& P = particles_;
+  // The update sweep's summary when it is this step's and no particle has left since.
+  const StepSummary acc = summary_step_ == steps_ ? summary_ : summarise_particles();
+  summary_step_ = -1;
   const double dx = scene_.dx;
   // Where an error happened (built only on the error paths below; this runs every step).
   // During settling the step count and time restart at 0 afterwards: say so.

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -48,6 +49,10 @@ class Simulation {
   // (update_particles_2d); the two must agree bit for bit.
   void set_per_particle_update(bool on) { per_particle_update_ = on; }
   const std::vector<StageStats>& stages() const { return stages_; }
+  // The per-particle effects that the update sweep applies to each particle right after its
+  // update, in this order (bed_projection, drive, domain_clamp): they are not stages of their
+  // own, and their time is in the update's stage.
+  const std::vector<std::string>& particle_effects() const { return particle_effects_; }
   std::int64_t return_map_evaluations() const { return return_map_evaluations_; }
   std::int64_t particle_steps() const { return particle_steps_; }
 
@@ -89,6 +94,25 @@ class Simulation {
     std::function<void()> run;
   };
   void add_stage(std::string name, std::function<void()> run);
+  // The time step's reduction over the particles: the largest |v|², the front, the first
+  // particle with a non-finite velocity or stress.
+  struct StepSummary {
+    double v2 = 0.0;
+    double front = -std::numeric_limits<double>::infinity();
+    std::int64_t bad = -1;
+  };
+  static StepSummary merge(StepSummary a, const StepSummary& b);
+  void summarise_particle(std::size_t p, StepSummary& acc) const;
+  StepSummary summarise_particles() const;
+  // What the update sweep does to each particle after its update (particle_effects()), and the
+  // particle's share of the time step's summary. The drive's place and speed are those at the
+  // end of the step.
+  struct ParticleTail {
+    bool bed = false, drive = false;
+    double drive_shift = 0.0, drive_v = 0.0;
+  };
+  ParticleTail particle_tail() const;
+  void finish_particle(std::size_t p, const ParticleTail& tail, StepSummary& acc);
   void seed_particles();
   void build_bed_table();
 
@@ -98,7 +122,6 @@ class Simulation {
   template <class Fn>
   void for_each_particle_coloured(Fn&& fn);  // race-free P2G-style traversal by x-slab parity
   void grid_velocity(const Vec<Dim>& gravity);
-  void drive_back_layer();
   void drive_grid_nodes();
   void apply_bed_friction_to_grid();
   void apply_walls_to_grid(const std::vector<int>& axes, const Vec<Dim>& lo, const Vec<Dim>& hi);
@@ -123,11 +146,10 @@ class Simulation {
   void update_all_particles();
   // 2D: the same update over a block of particles at a time (simulation.cpp).
   template <bool Plastic>
-  void update_particles_2d(std::size_t begin, std::size_t end, bool damage, bool plastic);
+  void update_particles_2d(std::size_t begin, std::size_t end, bool damage, bool plastic,
+                           const ParticleTail& tail, StepSummary& acc);
   template <bool Plastic>
   void finish_step();
-  void project_particles_out_of_bed();
-  void clamp_particles(const Vec<Dim>& lo, const Vec<Dim>& hi);
   void remove_outflow();
   void init_gate();
   void record_gate();
@@ -140,7 +162,7 @@ class Simulation {
   };
   BedCell bed_cell(const Vec<Dim>& x) const;
   double bed_phi(const BedCell& cell, Vec<Dim>* normal) const;
-  void project_out_of_bed(std::size_t p);  // one particle of project_particles_out_of_bed
+  void project_out_of_bed(std::size_t p);  // one particle's bed projection (finish_particle)
 
   SceneConfig scene_;
   ElasticModuli moduli_;
@@ -159,6 +181,11 @@ class Simulation {
 
   std::vector<Stage> stage_fns_;
   std::vector<StageStats> stages_;
+  std::vector<std::string> particle_effects_;
+  // The summary the update sweep reduced, for the time step of the same step (steps_ then);
+  // stale once the outflow has removed particles.
+  StepSummary summary_;
+  std::int64_t summary_step_ = -1;
   // P2G colouring: particle indices grouped by x-slab of kSlabCells cells, and the per-block
   // slab counts of the parallel counting sort that builds it (reused every step).
   std::vector<std::uint32_t> slab_order_;

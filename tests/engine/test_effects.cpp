@@ -2,6 +2,10 @@
 // adds no stage and no per-particle storage; an elastic scene never runs the return mapping.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <string>
+#include <vector>
+
 #include "engine/simulation.hpp"
 #include "scene_builders.hpp"
 
@@ -64,24 +68,33 @@ TEST(Effects, UnreachedPlasticityGivesTheElasticResultBitForBit) {
 TEST(Effects, StagesFollowTheEffectList) {
   Simulation<2> bare(block({}));
   const auto& st = bare.stages();
+  const auto has_effect = [](const auto& sim, const std::string& name) {
+    const auto& e = sim.particle_effects();
+    return std::find(e.begin(), e.end(), name) != e.end();
+  };
   for (const char* absent :
        {"basal_friction", "bed_projection", "box_walls", "lateral_walls", "velocity_boundaries",
         "drive", "outflow", "settle_damping", "grid_velocity_gravity", "g2p_return_mapping"}) {
     EXPECT_FALSE(has_stage(st, absent)) << absent;
+    EXPECT_FALSE(has_effect(bare, absent)) << absent;
   }
   EXPECT_TRUE(has_stage(st, "grid_velocity"));  // no gravity term
+  // The clamp is always applied, by the update sweep to each particle.
+  EXPECT_EQ(bare.particle_effects(), std::vector<std::string>{"domain_clamp"});
 
   SceneConfig full_scene =
       block({Effect::gravity, Effect::basal_friction, Effect::box_walls,
              Effect::velocity_boundaries, Effect::outflow, Effect::plasticity, Effect::softening});
   Simulation<2> full(full_scene);
   for (const char* present :
-       {"basal_friction", "bed_projection", "box_walls", "velocity_boundaries", "outflow",
+       {"basal_friction", "box_walls", "velocity_boundaries", "outflow",
         "grid_velocity_gravity", "g2p_return_mapping"}) {
     EXPECT_TRUE(has_stage(full.stages(), present)) << present;
   }
+  EXPECT_EQ(full.particle_effects(), (std::vector<std::string>{"bed_projection", "domain_clamp"}));
   EXPECT_FALSE(has_stage(full.stages(), "lateral_walls"));  // 3D only, and not named
   EXPECT_FALSE(has_stage(full.stages(), "drive"));
+  EXPECT_FALSE(has_effect(full, "drive"));
   full.step();
   for (const auto& s : full.stages()) EXPECT_EQ(s.calls, 1) << s.name;
 }
