@@ -10,7 +10,8 @@
 // The stress is a linear stand-in (small-strain Hooke's law on F), not a material model: it
 // only makes τ a function of F, written once. The storage layout is the engine's (one array of
 // Eigen fixed-size vectors/matrices per field, double). Counters: particle_steps_per_s and
-// state_B (bytes per particle of the state read and written).
+// state_B (bytes per particle of the state read and written); ns per particle-step of P2G (with
+// the grid clear), the grid update and G2P.
 #include <benchmark/benchmark.h>
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
@@ -19,6 +20,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <numeric>
 #include <string>
@@ -104,12 +106,25 @@ class LimitKernel {
   }
 
   void step() {
+    using clock = std::chrono::steady_clock;
+    const auto t0 = clock::now();
     clear_grid();
     particle_to_grid();
+    const auto t1 = clock::now();
     grid_update();
+    const auto t2 = clock::now();
     const double vmax = grid_to_particle();
     dt_ = cfl_ * dx_ / (p_wave_speed_ + vmax);
+    const auto t3 = clock::now();
+    phase_seconds_[0] += std::chrono::duration<double>(t1 - t0).count();
+    phase_seconds_[1] += std::chrono::duration<double>(t2 - t1).count();
+    phase_seconds_[2] += std::chrono::duration<double>(t3 - t2).count();
   }
+
+  // Seconds spent in (grid clear + P2G, grid update, G2P) since the last reset.
+  static constexpr std::array<const char*, 3> kPhases = {"p2g", "grid", "g2p"};
+  const std::array<double, 3>& phase_seconds() const { return phase_seconds_; }
+  void reset_phase_seconds() { phase_seconds_ = {}; }
 
  private:
   int base_x_of(const Vec<Dim>& x) const { return static_cast<int>(std::floor(x[0] / dx_ - 0.5)); }
@@ -210,6 +225,7 @@ class LimitKernel {
     return std::sqrt(v2);
   }
 
+  std::array<double, 3> phase_seconds_{};
   double dx_, cfl_, p_wave_speed_;
   ElasticModuli moduli_;
   double dt_ = 0.0;
@@ -232,6 +248,7 @@ void limit_benchmark(benchmark::State& state, int threads) {
                                   static_cast<std::size_t>(threads));
   LimitKernel<Dim> kernel(block_scene(Dim, Material::elastic));
   for (int i = 0; i < kWarmupSteps; ++i) kernel.step();
+  kernel.reset_phase_seconds();
   std::int64_t psteps = 0;
   for (auto _ : state) {
     kernel.step();
@@ -242,6 +259,10 @@ void limit_benchmark(benchmark::State& state, int threads) {
   c["particle_steps_per_s"] =
       benchmark::Counter(static_cast<double>(psteps), benchmark::Counter::kIsRate);
   c["state_B"] = kernel.state_bytes_per_particle();
+  // ns per particle-step of each phase, as bench_step reports the engine's stages.
+  for (std::size_t k = 0; k < LimitKernel<Dim>::kPhases.size(); ++k)
+    c[std::string("ns_") + LimitKernel<Dim>::kPhases[k]] =
+        1e9 * kernel.phase_seconds()[k] / static_cast<double>(psteps);
 }
 
 void register_all() {

@@ -4,7 +4,7 @@
 //  * particle_steps_per_s (rate over wall time) and ns_<stage>: wall nanoseconds per
 //    particle-step of each named stage of the step (Simulation::stages());
 //  * particle_B / grid_B: bytes per particle of the per-particle arrays of Particles<Dim>
-//    (capacity × element size) and of the background grid (mass + velocity per node);
+//    (capacity × element size) and of the background grid (GridNode per node);
 //  * sortstep/…: sort_step_peak_heap_B, the peak heap per particle during step 100 (a later
 //    sorting step, arrays at their steady size), against heap_B just before it;
 //  * heap_B / peak_heap_B / first_step_peak_heap_B: live heap held by the simulation after the
@@ -98,8 +98,8 @@ double particle_array_bytes(const Particles<Dim>& P) {
          vector_bytes(P.eps_v_p) + vector_bytes(P.drive_x0);
 }
 
-// Nodes of the grid box the engine fits to the particles' stencils (Grid<Dim>: one mass and
-// one velocity per node).
+// Nodes of the grid box the engine fits to the particles' stencils (Grid<Dim>: one GridNode of
+// mass, intact mass and velocity per node).
 template <int Dim>
 double grid_bytes(const Particles<Dim>& P, double dx) {
   IVec<Dim> lo = IVec<Dim>::Constant(std::numeric_limits<int>::max());
@@ -113,7 +113,7 @@ double grid_bytes(const Particles<Dim>& P, double dx) {
   }
   double nodes = 1.0;
   for (int a = 0; a < Dim; ++a) nodes *= hi[a] - lo[a] + 1;
-  return nodes * (sizeof(double) + sizeof(Vec<Dim>));
+  return nodes * sizeof(GridNode<Dim>);
 }
 
 template <int Dim>

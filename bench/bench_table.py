@@ -6,7 +6,9 @@ Usage: bench_table.py STEP.json LIMIT.json [--stages]
 Every number is the median over the repetitions (--benchmark_repetitions); the ± column is the
 standard deviation of the rate over them, relative. Stages are grouped into phases: prepare
 (sort, grid box, P2G colouring), P2G, grid (velocity, gravity, boundary conditions), G2P (gather,
-volume averaging, F update and material) and other (bed projection, clamp, time step).
+volume averaging, F update and material, and the per-particle effects the update sweep applies:
+bed projection, piston, clamp, the time step's reduction) and other (the time step). The limit
+kernel's rows give its own phases (its grid clear is in P2G).
 --stages prints every stage's ns per particle-step instead of the phase columns.
 """
 import json
@@ -15,7 +17,7 @@ import sys
 PHASES = {
     "prepare": ["prepare_grid"],
     "p2g": ["p2g"],
-    "grid": ["grid_velocity", "grid_velocity_gravity", "basal_friction", "box_walls",
+    "grid": ["grid", "grid_velocity", "grid_velocity_gravity", "basal_friction", "box_walls",
              "lateral_walls", "velocity_boundaries", "settle_damping"],
     "g2p": ["g2p_velocity", "volume_averaging", "g2p_elastic", "g2p_return_mapping"],
 }
@@ -120,7 +122,9 @@ def main(argv):
         if material == "limit":
             cells = [f"{dim.upper()} limit kernel, {threads} thread{'s' if threads > 1 else ''}",
                      f"{med['particles']:.0f}", f"{rate[k] / 1e6:.2f}", spread(k), "100%", speedup, cpu, cpu_frac,
-                     f"{med['state_B']:.0f}", "", "", "", "", "", "", "", ""]
+                     f"{med['state_B']:.0f}", "", "", ""] + \
+                    [f"{phase_ns(med)[p]:.0f}" if any(x.startswith("ns_") for x in med) else ""
+                     for p in ["prepare", "p2g", "grid", "g2p", "other"]]
         else:
             ph = phase_ns(med)
             cells = [f"{dim.upper()} {material}, {threads} thread{'s' if threads > 1 else ''}",

@@ -8,13 +8,22 @@
 
 namespace crevasse {
 
+// One node's sums, together: P2G adds to all three at once, so a node is one place in memory
+// (32 bytes in 2D) instead of one in each of three arrays.
+template <int Dim>
+struct GridNode {
+  double mass = 0.0;
+  // Σ w m (1 − D) of the particles around: the weight of the ΔJ-bar average (simulation.cpp).
+  double intact_mass = 0.0;
+  Vec<Dim> vel = Vec<Dim>::Zero();  // momentum during P2G, velocity after the grid update
+};
+
 template <int Dim>
 struct Grid {
   double dx = 1.0;
   IVec<Dim> lo = IVec<Dim>::Zero();
   IVec<Dim> n = IVec<Dim>::Zero();
-  std::vector<double> mass;
-  std::vector<Vec<Dim>> vel;  // momentum during P2G, velocity after the grid update
+  std::vector<GridNode<Dim>> nodes;
 
   std::size_t node_count() const {
     std::size_t c = 1;
@@ -39,8 +48,7 @@ struct Grid {
   void reset(const IVec<Dim>& new_lo, const IVec<Dim>& new_n) {
     lo = new_lo;
     n = new_n;
-    mass.assign(node_count(), 0.0);
-    vel.assign(node_count(), Vec<Dim>::Zero());
+    nodes.assign(node_count(), GridNode<Dim>{});
   }
 };
 

@@ -114,7 +114,7 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
     add_stage("settle_damping", [this] {
       if (!settling_) return;
       const double f = std::exp(-settle_damping_rate_ * dt_);
-      for (auto& v : grid_.vel) v *= f;
+      for (auto& g : grid_.nodes) g.vel *= f;
     });
   }
   const bool plastic = scene_.has(Effect::plasticity);
@@ -463,11 +463,24 @@ void Simulation<Dim>::prepare_grid() {
 
 template <int Dim>
 void Simulation<Dim>::particle_to_grid() {
+  if (scene_.volumetric_averaging) scatter_to_grid<true>();
+  else scatter_to_grid<false>();
+}
+
+template <int Dim>
+template <bool Average>
+void Simulation<Dim>::scatter_to_grid() {
   const auto& P = particles_;
   const double dx = scene_.dx, inv_dx = 1.0 / dx;
   const double d_inv = 4.0 * inv_dx * inv_dx;  // MLS inertia-like tensor inverse for quadratic B-splines
   const double dt = dt_;
-  for_each_particle_coloured([&](std::uint32_t p) {
+  // With the ΔJ-bar average, each particle also adds its intact mass m (1 − D), the weight of
+  // the average (gather_velocities_and_scatter_volume), and keeps its e^{−ζ ε_v^p} for the
+  // sweeps after (ε_v^p does not change before the update).
+  const bool plastic = Average && !P.eps_v_p.empty();
+  const bool damage = Average && averaging_weights_damage();
+  softening_.resize(plastic ? P.size() : 0);
+  for_each_particle_coloured([&](std::uint32_t p) __attribute__((always_inline)) {
     const Vec<Dim> xg = P.x[p] * inv_dx;
     const StencilWeights<Dim> w(xg);
     const IVec<Dim> base = w.base();
@@ -475,12 +488,19 @@ void Simulation<Dim>::particle_to_grid() {
     // −dt·V0·τ·D⁻¹ with D⁻¹ = 4/dx² for quadratic B-splines.
     const Mat<Dim> affine = P.mass[p] * P.C[p] - (dt * d_inv * P.vol0[p]) * P.tau[p];
     const Vec<Dim> mv = P.mass[p] * P.v[p];
+    double wm = 0.0;
+    if constexpr (Average) {
+      const double f = plastic ? softening_factor(plastic_, P.eps_v_p[p]) : 1.0;
+      if (plastic) softening_[p] = f;
+      wm = P.mass[p] * (damage ? f : 1.0);
+    }
     for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
       const IVec<Dim> node = base + off;
       const Vec<Dim> dpos = (node.template cast<double>() - xg) * dx;
-      const std::size_t f = grid_.flat(node);
-      grid_.mass[f] += wt * P.mass[p];
-      grid_.vel[f] += wt * (mv + affine * dpos);
+      GridNode<Dim>& g = grid_.nodes[grid_.flat(node)];
+      g.mass += wt * P.mass[p];
+      if constexpr (Average) g.intact_mass += wt * wm;
+      g.vel += wt * (mv + affine * dpos);
     });
   });
 }
@@ -504,7 +524,7 @@ void Simulation<Dim>::grid_velocity(const Vec<Dim>& gravity) {
   const double dt = dt_;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid_.node_count(), kGrain), [&](const auto& r) {
     for (std::size_t f = r.begin(); f != r.end(); ++f) {
-      if (grid_.mass[f] > 0.0) grid_.vel[f] = grid_.vel[f] / grid_.mass[f] + dt * gravity;
+      if (grid_.nodes[f].mass > 0.0) grid_.nodes[f].vel = grid_.nodes[f].vel / grid_.nodes[f].mass + dt * gravity;
     }
   });
 }
@@ -530,9 +550,9 @@ void Simulation<Dim>::drive_grid_nodes() {
     });
   }
   for (std::size_t f = 0; f < drive_node_mass_.size(); ++f) {
-    if (drive_node_mass_[f] <= 0.0 || grid_.mass[f] <= 0.0) continue;
-    const double share = std::min(1.0, drive_node_mass_[f] / grid_.mass[f]);
-    grid_.vel[f][0] += share * (v - grid_.vel[f][0]);
+    if (drive_node_mass_[f] <= 0.0 || grid_.nodes[f].mass <= 0.0) continue;
+    const double share = std::min(1.0, drive_node_mass_[f] / grid_.nodes[f].mass);
+    grid_.nodes[f].vel[0] += share * (v - grid_.nodes[f].vel[0]);
   }
 }
 
@@ -544,7 +564,7 @@ void Simulation<Dim>::apply_bed_friction_to_grid() {
   const double mu = scene_.bed_friction;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid_.node_count(), kGrain), [&](const auto& r) {
     for (std::size_t f = r.begin(); f != r.end(); ++f) {
-      if (grid_.mass[f] <= 0.0) continue;
+      if (grid_.nodes[f].mass <= 0.0) continue;
       const IVec<Dim> node = grid_.node_of(f);
       const int i = node[0] - bed_i0_, k = node[up_axis<Dim>] - bed_k0_;
       if (i < 0 || k < 0 || i >= bed_ni_ || k >= bed_nk_) continue;
@@ -554,7 +574,7 @@ void Simulation<Dim>::apply_bed_friction_to_grid() {
       Vec<Dim> n = Vec<Dim>::Zero();
       n[0] = bed_normal_[t][0];
       n[up_axis<Dim>] = bed_normal_[t][1];
-      Vec<Dim>& v = grid_.vel[f];
+      Vec<Dim>& v = grid_.nodes[f].vel;
       const double vn = v.dot(n);
       if (vn >= 0.0) continue;
       Vec<Dim> vt = v - vn * n;
@@ -572,11 +592,11 @@ void Simulation<Dim>::apply_walls_to_grid(const std::vector<int>& axes, const Ve
   // Free slip: on nodes at or beyond a wall the velocity into the wall is removed.
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid_.node_count(), kGrain), [&](const auto& r) {
     for (std::size_t f = r.begin(); f != r.end(); ++f) {
-      if (grid_.mass[f] <= 0.0) continue;
+      if (grid_.nodes[f].mass <= 0.0) continue;
       const Vec<Dim> xn = grid_.position(grid_.node_of(f));
       for (int a : axes) {
-        if (xn[a] <= lo[a] + 1e-9 * grid_.dx) grid_.vel[f][a] = std::max(grid_.vel[f][a], 0.0);
-        if (xn[a] >= hi[a] - 1e-9 * grid_.dx) grid_.vel[f][a] = std::min(grid_.vel[f][a], 0.0);
+        if (xn[a] <= lo[a] + 1e-9 * grid_.dx) grid_.nodes[f].vel[a] = std::max(grid_.nodes[f].vel[a], 0.0);
+        if (xn[a] >= hi[a] - 1e-9 * grid_.dx) grid_.nodes[f].vel[a] = std::min(grid_.nodes[f].vel[a], 0.0);
       }
     }
   });
@@ -588,9 +608,9 @@ void Simulation<Dim>::apply_velocity_boxes_to_grid() {
     const Vec<Dim> v = to_vec<Dim>(b.velocity);
     const Vec<Dim> lo = to_vec<Dim>(b.min) + v * time_, hi = to_vec<Dim>(b.max) + v * time_;
     for (std::size_t f = 0; f < grid_.node_count(); ++f) {
-      if (grid_.mass[f] <= 0.0) continue;
+      if (grid_.nodes[f].mass <= 0.0) continue;
       const Vec<Dim> xn = grid_.position(grid_.node_of(f));
-      if ((xn.array() >= lo.array()).all() && (xn.array() <= hi.array()).all()) grid_.vel[f] = v;
+      if ((xn.array() >= lo.array()).all() && (xn.array() <= hi.array()).all()) grid_.nodes[f].vel = v;
     }
   }
 }
@@ -611,7 +631,7 @@ template <int Dim>
     const IVec<Dim> node = base + off;
     double dpos[Dim];
     for (int j = 0; j < Dim; ++j) dpos[j] = (static_cast<double>(node[j]) - xg[j]) * dx;
-    const Vec<Dim>& vi = grid_.vel[grid_.flat(node)];
+    const Vec<Dim>& vi = grid_.nodes[grid_.flat(node)].vel;
     for (int i = 0; i < Dim; ++i) {
       const double wv = wt * vi[i];
       v[i] += wv;
@@ -641,8 +661,18 @@ void Simulation<Dim>::update_particle(std::size_t p, double volume_scale, double
   P.x[p] += dt_ * P.v[p];
   Mat<Dim> df = Mat<Dim>::Identity() + dt_ * P.C[p];
   if (volume_scale != 1.0) df *= volume_root<Dim>(volume_scale);
-  Mat<Dim> fe = df * P.F_e[p];
-  PrincipalStretch<Dim> s = principal_hencky<Dim>(fe);
+  const Mat<Dim> fe = df * P.F_e[p];
+  store_trial_state<Plastic>(p, fe, principal_hencky<Dim>(fe), softening);
+}
+
+template <int Dim>
+template <bool Plastic>
+[[gnu::always_inline]] inline void Simulation<Dim>::store_trial_state(std::size_t p, Mat<Dim> fe,
+                                                                      PrincipalStretch<Dim> s,
+                                                                      double softening) {
+  // From the trial F_E and its principal Hencky strains: the return mapping when the scene is
+  // plastic, then F_E and the stress.
+  auto& P = particles_;
   if constexpr (Plastic) {
     const ReturnResult<Dim> ret = return_map_capped_von_mises<Dim>(s.eps, P.eps_v_p[p], moduli_, plastic_, softening);
     if (ret.cap_active || ret.shear_active) {
@@ -737,22 +767,17 @@ void Simulation<Dim>::gather_velocities_and_scatter_volume() {
   auto& P = particles_;
   const double inv_dx = 1.0 / scene_.dx;
   const bool damage = averaging_weights_damage();
-  grid_aux_.assign(2 * grid_.node_count(), 0.0);  // interleaved (Σ w m (1−D) ΔJ, Σ w m (1−D))
+  grid_aux_.assign(2 * grid_.node_count(), 0.0);  // per node Σ w m (1−D) ΔJ, then (ΔJ̄, has one)
   const bool plastic = !P.eps_v_p.empty();
-  softening_.resize(plastic ? P.size() : 0);
-  for_each_particle_coloured([&](std::uint32_t p) {
+  for_each_particle_coloured([&](std::uint32_t p) __attribute__((always_inline)) {
     const Vec<Dim> xg = P.x[p] * inv_dx;
     const StencilWeights<Dim> w(xg);
     gather_velocity(p, w, xg);
     const double dj = (Mat<Dim>::Identity() + dt_ * P.C[p]).determinant();
-    const double f = plastic ? softening_factor(plastic_, P.eps_v_p[p]) : 1.0;
-    if (plastic) softening_[p] = f;
-    const double wm = P.mass[p] * (damage ? f : 1.0);
+    const double wm = P.mass[p] * (damage && plastic ? softening_[p] : 1.0);  // as P2G's
     const IVec<Dim> base = w.base();
     for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
-      const std::size_t node = 2 * grid_.flat(base + off);
-      grid_aux_[node] += wt * wm * dj;
-      grid_aux_[node + 1] += wt * wm;
+      grid_aux_[2 * grid_.flat(base + off)] += wt * wm * dj;
     });
   });
 }
@@ -763,8 +788,9 @@ void Simulation<Dim>::normalise_volume_average() {
   // (nearly) broken ice do not).
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid_.node_count(), kGrain), [&](const auto& r) {
     for (std::size_t f = r.begin(); f != r.end(); ++f) {
-      const bool has = grid_aux_[2 * f + 1] > 1e-9 * grid_.mass[f];
-      grid_aux_[2 * f] = has ? grid_aux_[2 * f] / grid_aux_[2 * f + 1] : 0.0;
+      const double intact = grid_.nodes[f].intact_mass;
+      const bool has = intact > 1e-9 * grid_.nodes[f].mass;
+      grid_aux_[2 * f] = has ? grid_aux_[2 * f] / intact : 0.0;
       grid_aux_[2 * f + 1] = has ? 1.0 : 0.0;
     }
   });
@@ -837,8 +863,9 @@ void Simulation<Dim>::update_all_particles() {
 // ΔF·F_E and the closed-form eigen-solve up to the logarithms' arguments; (5) the two logarithms,
 // one by one; (6) over the block, the frame, τ and the two yield tests; then the stores. The
 // compiler keeps two particles per vector register in (2), (4) and (6). A particle whose trial
-// state is outside a yield surface (a few at cracks) is not stored from the block:
-// update_particle updates it from its unchanged state.
+// state is outside a yield surface (at cracks: many once a glacier has cracked) goes from the
+// block's trial state through the return mapping (store_trial_state), as in update_particle;
+// each particle then takes the step's per-particle effects (finish_particle).
 template <int Dim>
 template <bool Plastic>
 void Simulation<Dim>::update_particles_2d(std::size_t begin, std::size_t end, bool damage,
@@ -855,7 +882,8 @@ void Simulation<Dim>::update_particles_2d(std::size_t begin, std::size_t end, bo
   std::int64_t need_pow[kBlock];
   double f00[kBlock], f01[kBlock], f10[kBlock], f11[kBlock];
   double m[kBlock], h[kBlock], d[kBlock], r[kBlock], jm1[kBlock], e0[kBlock], e1[kBlock];
-  double t00[kBlock], t11[kBlock], t01[kBlock];
+  double t00[kBlock], t11[kBlock], t01[kBlock], ux[kBlock], uy[kBlock];
+  std::int64_t spread[kBlock];
   std::int64_t elastic[kBlock];  // 0 or 1: the width of a double, so that the loop below vectorises
   for (std::size_t b = begin; b < end; b += kBlock) {
     const std::size_t n = std::min(kBlock, end - b);
@@ -901,21 +929,27 @@ void Simulation<Dim>::update_particles_2d(std::size_t begin, std::size_t end, bo
       e0[i] = std::log1p(jm1[i]) - e1[i];
     }
     for (std::size_t i = 0; i < n; ++i) {
-      double ux, uy;
-      detail::hencky_2d_frame({m[i], h[i], d[i], r[i], jm1[i]}, ux, uy);
-      kirchhoff_stress_2d(moduli, e0[i], e1[i], ux, uy, t00[i], t11[i], t01[i]);
+      spread[i] = detail::hencky_2d_frame({m[i], h[i], d[i], r[i], jm1[i]}, ux[i], uy[i]);
+      kirchhoff_stress_2d(moduli, e0[i], e1[i], ux[i], uy[i], t00[i], t11[i], t01[i]);
       if constexpr (Plastic) elastic[i] = admissible_2d(e0[i], e1[i], moduli, plastic_params, soft[i]);
     }
     for (std::size_t i = 0; i < n; ++i) {
       const std::size_t p = b + i;
+      P.x[p] += dt * P.v[p];
       if constexpr (Plastic) {
         if (!elastic[i]) {
-          update_particle<true>(p, vs[i], soft[i]);
+          // Outside a yield surface: the return mapping, from the block's trial state, which
+          // is update_particle's to the bit (principal_hencky_2d chains the same parts).
+          Mat<2> trial;
+          trial << f00[i], f01[i], f10[i], f11[i];
+          PrincipalStretch<2> st;
+          st.eps << e0[i], e1[i];
+          st.U << uy[i], ux[i], spread[i] ? -ux[i] : 0.0, uy[i];
+          store_trial_state<true>(p, trial, st, soft[i]);
           finish_particle(p, tail, acc);
           continue;
         }
       }
-      P.x[p] += dt * P.v[p];
       Mat<2>& fe = P.F_e[p];
       fe(0, 0) = f00[i];
       fe(1, 0) = f10[i];

@@ -102,7 +102,7 @@ class Simulation {
     std::int64_t bad = -1;
   };
   static StepSummary merge(StepSummary a, const StepSummary& b);
-  void summarise_particle(std::size_t p, StepSummary& acc) const;
+  [[gnu::always_inline]] inline void summarise_particle(std::size_t p, StepSummary& acc) const;
   StepSummary summarise_particles() const;
   // What the update sweep does to each particle after its update (particle_effects()), and the
   // particle's share of the time step's summary. The drive's place and speed are those at the
@@ -112,13 +112,15 @@ class Simulation {
     double drive_shift = 0.0, drive_v = 0.0;
   };
   ParticleTail particle_tail() const;
-  void finish_particle(std::size_t p, const ParticleTail& tail, StepSummary& acc);
+  [[gnu::always_inline]] inline void finish_particle(std::size_t p, const ParticleTail& tail, StepSummary& acc);
   void seed_particles();
   void build_bed_table();
 
   // Stages.
   void prepare_grid();
   void particle_to_grid();
+  template <bool Average>
+  void scatter_to_grid();  // P2G, with the ΔJ-bar average's weights when Average
   template <class Fn>
   void for_each_particle_coloured(Fn&& fn);  // race-free P2G-style traversal by x-slab parity
   void grid_velocity(const Vec<Dim>& gravity);
@@ -131,6 +133,8 @@ class Simulation {
   void gather_velocity(std::size_t p, const StencilWeights<Dim>& w, const Vec<Dim>& xg);
   template <bool Plastic>
   void update_particle(std::size_t p, double volume_scale, double softening);  // softening: e^{−ζ ε_v^p}
+  template <bool Plastic>
+  void store_trial_state(std::size_t p, Mat<Dim> fe, PrincipalStretch<Dim> s, double softening);
   // ΔJ-bar volume averaging fused into the G2P sweeps (simulation.cpp explains it): gather v, C
   // and scatter the weighted ΔJ in one coloured sweep; normalise per node; the update sweep
   // interpolates ΔJ̄ back and updates the particle at once.
@@ -162,7 +166,7 @@ class Simulation {
   };
   BedCell bed_cell(const Vec<Dim>& x) const;
   double bed_phi(const BedCell& cell, Vec<Dim>* normal) const;
-  void project_out_of_bed(std::size_t p);  // one particle's bed projection (finish_particle)
+  [[gnu::always_inline]] inline void project_out_of_bed(std::size_t p);  // one particle's bed projection (finish_particle)
 
   SceneConfig scene_;
   ElasticModuli moduli_;
@@ -191,10 +195,10 @@ class Simulation {
   std::vector<std::uint32_t> slab_order_;
   std::vector<std::uint32_t> slab_start_;
   std::vector<std::uint32_t> slab_block_offsets_;
-  // Volume averaging scratch (reused every step): per node (Σ w m (1−D) ΔJ, Σ w m (1−D)), then
-  // (averaged ΔJ, whether the node carries one).
+  // Volume averaging scratch (reused every step): per node (Σ w m (1−D) ΔJ, unused), then
+  // (averaged ΔJ, whether the node carries one); the weights Σ w m (1−D) are in the grid nodes.
   std::vector<double> grid_aux_;
-  std::vector<double> softening_;  // per particle e^{−ζ ε_v^p} (plastic scenes), from G2P to the update
+  std::vector<double> softening_;  // per particle e^{−ζ ε_v^p} (plastic scenes), from P2G to the update
   std::vector<double> drive_node_mass_;  // per node: mass from the driven layer (drive_grid)
 
   Vec<Dim> domain_lo_, domain_hi_;
