@@ -1,43 +1,48 @@
 #!/usr/bin/env python3
-"""Prints the benchmark table of issue 6 from the JSON of bench_step and bench_limit.
+"""Prints the benchmark table of issue 6 from the rounds that scripts/bench.sh ran.
 
-Usage: bench_table.py STEP.json LIMIT.json [--stages]
+Usage: bench_table.py DIR [--stages]
 
-Every number is the median over the repetitions (--benchmark_repetitions); the ± column is the
-standard deviation of the rate over them, relative. Stages are grouped into phases: prepare
-(sort, grid box, P2G colouring), P2G, grid (velocity, gravity, boundary conditions), G2P (gather,
-volume averaging, F update and material, and the per-particle effects the update sweep applies:
-bed projection, piston, clamp, the time step's reduction) and other (the time step). The limit
-kernel's rows give its own phases (its grid clear is in P2G).
---stages prints every stage's ns per particle-step instead of the phase columns.
+DIR holds, per round R and group G (a dimension and a thread count), limit_R_G.json (the limit
+kernel) and step_R_G.json (the engine's elastic and softening steps), each one repetition, run
+one right after the other; and sortstep.json (the sorting-step heap). Interleaving makes the
+fraction of the limit robust to a machine whose speed drifts: each round's engine rate is divided
+by the limit's rate of the same round, and the table gives the median of those ratios. Every
+other number is the median over the rounds; the ± column is the standard deviation of the rate
+over them, relative. 2T/1T is the median over the rounds of the two-thread over the one-thread
+rate. Stages are grouped into phases: prepare (sort, grid box, P2G colouring), P2G, grid
+(velocity, gravity, boundary conditions), G2P (gather, volume averaging, F update and material,
+and the per-particle effects the update sweep applies: bed projection, piston, clamp, the time
+step's reduction) and other (the time step). The limit kernel's rows give its own phases (its
+grid clear is in P2G). --stages prints every stage's ns per particle-step instead.
 """
+import glob
 import json
+import os
+import re
+import statistics
 import sys
 
 PHASES = {
     "prepare": ["prepare_grid"],
     "p2g": ["p2g"],
     "grid": ["grid", "grid_velocity", "grid_velocity_gravity", "basal_friction", "box_walls",
-             "lateral_walls", "velocity_boundaries", "settle_damping"],
+             "lateral_walls", "velocity_boundaries", "settle_damping", "drive_grid"],
     "g2p": ["g2p", "g2p_velocity", "volume_averaging", "g2p_elastic", "g2p_return_mapping"],
 }
+UNITS = {"ns": 1e-9, "us": 1e-6, "ms": 1e-3, "s": 1.0}
 
 
-def load(path):
-    """{run_name: {aggregate_name: entry}} of a Google Benchmark JSON file."""
+def runs_of(path):
+    """The single-repetition runs of a Google Benchmark JSON file, by name without suffixes."""
     with open(path) as f:
         data = json.load(f)
-    runs = {}
+    out = {}
     for b in data["benchmarks"]:
-        if b["run_name"].startswith("sortstep/"):
-            # One repetition only (no aggregates): keep the single run as its "median".
-            runs.setdefault(b["run_name"].split("/iterations:")[0], {})["median"] = b
+        if b.get("run_type", "iteration") != "iteration":
             continue
-        if b.get("run_type") != "aggregate":
-            continue
-        name = b["run_name"].split("/iterations:")[0]
-        runs.setdefault(name, {})[b["aggregate_name"]] = b
-    return data.get("context", {}), runs
+        out[b["run_name"].split("/iterations:")[0]] = b
+    return out
 
 
 def key_of(name):
@@ -61,46 +66,54 @@ def phase_ns(entry):
 
 
 def main(argv):
-    if len(argv) < 3:
+    if len(argv) < 2 or not os.path.isdir(argv[1]):
         print(__doc__, file=sys.stderr)
         return 2
-    _, step_runs = load(argv[1])
-    _, limit_runs = load(argv[2])
+    folder = argv[1]
     show_stages = "--stages" in argv
-    rows = {}
+    # rounds[key] = {round: entry}
+    rounds = {}
+    for path in glob.glob(os.path.join(folder, "*_*_*.json")):
+        m = re.match(r"(limit|step)_(\d+)_", os.path.basename(path))
+        if not m:
+            continue
+        for name, entry in runs_of(path).items():
+            rounds.setdefault(key_of(name), {})[int(m.group(2))] = entry
+    if not rounds:
+        print(f"bench_table.py: no rounds in {folder}", file=sys.stderr)
+        return 2
     sort_steps = {}
-    for runs in (step_runs, limit_runs):
-        for name, aggs in runs.items():
-            if name.startswith("sortstep/"):
-                sort_steps[name] = aggs["median"]
-                continue
-            rows[key_of(name)] = aggs
-    rate = {k: a["median"]["particle_steps_per_s"] for k, a in rows.items()}
-    # One thread: particles per CPU-second of the benchmark thread, which a loaded machine
-    # disturbs less than the wall clock (the thread's own stalls still count).
-    units = {"ns": 1e-9, "us": 1e-6, "ms": 1e-3, "s": 1.0}
-    cpu_rate = {k: a["median"]["particles"] / (a["median"]["cpu_time"] * units[a["median"]["time_unit"]])
-                for k, a in rows.items() if k[2] == 1}
+    if os.path.exists(os.path.join(folder, "sortstep.json")):
+        sort_steps = runs_of(os.path.join(folder, "sortstep.json"))
 
-    def spread(k):
-        a = rows[k]
-        if "stddev" not in a or rate[k] == 0:
-            return ""
-        return f"{100.0 * a['stddev']['particle_steps_per_s'] / rate[k]:.0f}%"
+    def rate(k, r):
+        return rounds[k][r]["particle_steps_per_s"]
 
-    order = sorted(rows, key=lambda k: (k[0], k[1] != "limit", k[1], k[2]))
+    def median_of(k, field):
+        return statistics.median(e[field] for e in rounds[k].values())
+
+    def median_ratio(k, other):
+        common = sorted(set(rounds[k]) & set(rounds.get(other, {})))
+        if not common:
+            return None
+        return statistics.median(rate(k, r) / rate(other, r) for r in common)
+
+    def cpu_rate(k, r):
+        e = rounds[k][r]
+        return e["particles"] / (e["cpu_time"] * UNITS[e["time_unit"]])
+
+    order = sorted(rounds, key=lambda k: (k[0], k[1] != "limit", k[1], k[2]))
+    n_rounds = max(len(v) for v in rounds.values())
     if show_stages:
-        # The engine's stages, then the limit kernel's phases (p2g with its grid clear, grid,
-        # g2p), each in its own columns.
-        stages = sorted({s for k in order for s in rows[k]["median"] if s.startswith("ns_")})
+        stages = sorted({s for k in order for e in rounds[k].values() for s in e if s.startswith("ns_")})
         print("| stage (ns per particle-step) | " +
               " | ".join(f"{d} {m} {t}T" for d, m, t in order) + " |")
         print("|---|" + "---|" * len(order))
         for s in stages:
             cells = []
             for k in order:
-                v = rows[k]["median"].get(s)
-                cells.append(f"{v:.1f}" if v is not None else "")
+                values = [e[s] for e in rounds[k].values() if s in e]
+                cells.append(f"{statistics.median(values):.1f}" if values else "")
             print(f"| {s[3:]} | " + " | ".join(cells) + " |")
         return 0
 
@@ -111,42 +124,50 @@ def main(argv):
     print("|" + "---|" * len(header))
     for k in order:
         dim, material, threads = k
-        med = rows[k]["median"]
-        limit = rate.get((dim, "limit", threads))
-        one = rate.get((dim, material, 1))
-        frac = f"{100.0 * rate[k] / limit:.0f}%" if limit else ""
-        speedup = f"{rate[k] / one:.2f}×" if threads > 1 and one else ""
-        cpu = f"{cpu_rate[k] / 1e6:.2f}" if k in cpu_rate else ""
-        cpu_limit = cpu_rate.get((dim, "limit", 1))
-        cpu_frac = f"{100.0 * cpu_rate[k] / cpu_limit:.0f}%" if k in cpu_rate and cpu_limit else ""
+        rates = [e["particle_steps_per_s"] for e in rounds[k].values()]
+        med_rate = statistics.median(rates)
+        spread = f"{100.0 * statistics.stdev(rates) / med_rate:.0f}%" if len(rates) > 1 else ""
+        limit_key = (dim, "limit", threads)
+        frac = median_ratio(k, limit_key)
+        one = median_ratio(k, (dim, material, 1)) if threads > 1 else None
+        cpu = cpu_frac = ""
+        if threads == 1:
+            cpu = f"{statistics.median(cpu_rate(k, r) for r in rounds[k]) / 1e6:.2f}"
+            if limit_key in rounds:
+                common = sorted(set(rounds[k]) & set(rounds[limit_key]))
+                cpu_frac = f"{100.0 * statistics.median(cpu_rate(k, r) / cpu_rate(limit_key, r) for r in common):.0f}%"
+        first = rounds[k][min(rounds[k])]
+        ph = {p: statistics.median(phase_ns(e)[p] for e in rounds[k].values())
+              for p in ["prepare", "p2g", "grid", "g2p", "other"]}
+        label = f"{dim.upper()} {'limit kernel' if material == 'limit' else material}, " \
+                f"{threads} thread{'s' if threads > 1 else ''}"
+        common = [label, f"{first['particles']:.0f}", f"{med_rate / 1e6:.2f}", spread,
+                  f"{100.0 * frac:.0f}%" if frac else "", f"{one:.2f}×" if one else "", cpu, cpu_frac]
         if material == "limit":
-            cells = [f"{dim.upper()} limit kernel, {threads} thread{'s' if threads > 1 else ''}",
-                     f"{med['particles']:.0f}", f"{rate[k] / 1e6:.2f}", spread(k), "100%", speedup, cpu, cpu_frac,
-                     f"{med['state_B']:.0f}", "", "", ""] + \
-                    [f"{phase_ns(med)[p]:.0f}" if any(x.startswith("ns_") for x in med) else ""
-                     for p in ["prepare", "p2g", "grid", "g2p", "other"]]
+            cells = common + [f"{first['state_B']:.0f}", "", "", ""]
         else:
-            ph = phase_ns(med)
-            cells = [f"{dim.upper()} {material}, {threads} thread{'s' if threads > 1 else ''}",
-                     f"{med['particles']:.0f}", f"{rate[k] / 1e6:.2f}", spread(k), frac, speedup, cpu, cpu_frac,
-                     f"{med['particle_B']:.0f}", f"{med['grid_B']:.1f}",
-                     f"{med['heap_B']:.0f} ({med['peak_heap_B']:.0f}; {med.get('first_step_peak_heap_B', float('nan')):.0f})",
-                     f"{med['allocs_per_step']:.1f}"] + \
-                    [f"{ph[p]:.0f}" for p in ["prepare", "p2g", "grid", "g2p", "other"]]
+            cells = common + [f"{first['particle_B']:.0f}", f"{first['grid_B']:.1f}",
+                              f"{median_of(k, 'heap_B'):.0f} ({median_of(k, 'peak_heap_B'):.0f}; "
+                              f"{median_of(k, 'first_step_peak_heap_B'):.0f})",
+                              f"{median_of(k, 'allocs_per_step'):.1f}"]
+        cells += [f"{ph[p]:.0f}" for p in ["prepare", "p2g", "grid", "g2p", "other"]]
         print("| " + " | ".join(cells) + " |")
-    for name, med in sorted(sort_steps.items()):
+    for name, entry in sorted(sort_steps.items()):
         dim, what = name.split("/")[1].upper(), name.split("/")[2].replace("_", " ")
         print()
-        print(f"{dim} {what}, a later sorting step (step 100): heap {med['heap_B']:.0f} B/particle "
-              f"before it, peak {med['sort_step_peak_heap_B']:.0f} B/particle during it.")
+        print(f"{dim} {what}, a later sorting step (step 100): heap {entry['heap_B']:.0f} B/particle "
+              f"before it, peak {entry['sort_step_peak_heap_B']:.0f} B/particle during it.")
     print()
-    print("M pst/s: million particle-steps per second (wall clock), median; ±: its standard "
-          "deviation over the repetitions. of limit: fraction of the limit kernel at the same "
-          "dimension and thread count. 1T M pst/CPU-s: one-thread rate per CPU-second of the "
-          "benchmark thread (less disturbed by other load than the wall clock). particle B: per-particle arrays of Particles<Dim>; grid B: "
-          "grid mass and velocity; heap B: all heap the simulation holds, per particle, with its "
-          "peak during an ordinary step and during the first step (which sorts the particles). "
-          "prep … other: ns per particle-step of each phase (wall clock).")
+    print(f"{n_rounds} interleaved rounds (per round and group: the limit kernel, then the engine's "
+          "cases). M pst/s: million particle-steps per second (wall clock), median over the rounds; "
+          "±: its standard deviation over them. of limit: median over the rounds of the rate over "
+          "the limit kernel's rate of the same round, at the same dimension and thread count. "
+          "2T/1T: median over the rounds of the two-thread over the one-thread rate. 1T M pst/CPU-s: "
+          "one-thread rate per CPU-second of the benchmark thread (less disturbed by other load than "
+          "the wall clock). particle B: per-particle arrays of Particles<Dim>; grid B: grid nodes "
+          "(mass, intact mass, velocity); heap B: all heap the simulation holds, per particle, with "
+          "its peak during an ordinary step and during the first step (which sorts the particles). "
+          "prep … other: ns per particle-step of each phase (wall clock), median over the rounds.")
     return 0
 
 
