@@ -9,7 +9,7 @@
 #
 # Measured cost on the 2-core development VM, in case wall time (docs/study_format.md,
 # "Shipped studies"), before engine 5d23663, which about halves it with the same results
-# (spacing_vs_cohesion: 14 min at 5d23663, 12 min at 7f85433): spacing_vs_cohesion 36 min, spacing_replicas 9 min,
+# (spacing_vs_cohesion: 14 min at 5d23663, 10.5 min at 7f85433): spacing_vs_cohesion 36 min, spacing_replicas 9 min,
 # spacing_resolution 23 min, slope 5 min, step_length 6 min, three_d 31 min (3 cases),
 # two_d_long 3 min, three_d_long 38 min (2 cases, 19 min each side by side),
 # drive_speed_long 29 min, drive_speed_replicas 23 min, accuracy_drive 6 min and
