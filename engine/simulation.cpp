@@ -138,8 +138,10 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
     add_stage("g2p_elastic", [this] { grid_to_particle<false>(); });
   }
   // Applied by the update sweep to each particle as it is written (finish_particle).
-  if (scene_.has(Effect::basal_friction)) particle_effects_.push_back("bed_projection");
-  if (scene_.has(Effect::drive)) particle_effects_.push_back("drive");
+  tail_effects_.bed = scene_.has(Effect::basal_friction);
+  tail_effects_.drive = scene_.has(Effect::drive);
+  if (tail_effects_.bed) particle_effects_.push_back("bed_projection");
+  if (tail_effects_.drive) particle_effects_.push_back("drive");
   // Particles never leave the domain: the last line of defence, whatever the effects.
   particle_effects_.push_back("domain_clamp");
   if (scene_.records_gate()) add_stage("gate", [this] { record_gate(); });
@@ -492,7 +494,7 @@ void Simulation<Dim>::scatter_to_grid() {
     if constexpr (Average) {
       const double f = plastic ? softening_factor(plastic_, P.eps_v_p[p]) : 1.0;
       if (plastic) softening_[p] = f;
-      wm = P.mass[p] * (damage ? f : 1.0);
+      wm = averaging_weight(p, damage);
     }
     for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
       const IVec<Dim> node = base + off;
@@ -689,9 +691,7 @@ template <bool Plastic>
 
 template <int Dim>
 typename Simulation<Dim>::ParticleTail Simulation<Dim>::particle_tail() const {
-  ParticleTail t;
-  t.bed = scene_.has(Effect::basal_friction);
-  t.drive = scene_.has(Effect::drive);
+  ParticleTail t = tail_effects_;
   if (t.drive && !settling_) {
     // The piston's place at the end of this step: finish_step's time_ + dt_.
     const double end_time = time_ + dt_;
@@ -768,13 +768,12 @@ void Simulation<Dim>::gather_velocities_and_scatter_volume() {
   const double inv_dx = 1.0 / scene_.dx;
   const bool damage = averaging_weights_damage();
   grid_aux_.assign(2 * grid_.node_count(), 0.0);  // per node Σ w m (1−D) ΔJ, then (ΔJ̄, has one)
-  const bool plastic = !P.eps_v_p.empty();
   for_each_particle_coloured([&](std::uint32_t p) __attribute__((always_inline)) {
     const Vec<Dim> xg = P.x[p] * inv_dx;
     const StencilWeights<Dim> w(xg);
     gather_velocity(p, w, xg);
     const double dj = (Mat<Dim>::Identity() + dt_ * P.C[p]).determinant();
-    const double wm = P.mass[p] * (damage && plastic ? softening_[p] : 1.0);  // as P2G's
+    const double wm = averaging_weight(p, damage);  // the weight P2G added to intact_mass
     const IVec<Dim> base = w.base();
     for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
       grid_aux_[2 * grid_.flat(base + off)] += wt * wm * dj;

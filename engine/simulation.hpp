@@ -146,6 +146,12 @@ class Simulation {
   };
   VolumeSums volume_sums(std::size_t p, const StencilWeights<Dim>& w) const;
   bool averaging_weights_damage() const;  // the averaging weights each particle by 1 − D
+  // A particle's weight in the ΔJ-bar average, m (1 − D) when it weights damage (then softening_
+  // holds 1 − D = e^{−ζ ε_v^p}, set by P2G), m otherwise: P2G adds it to the nodes' intact_mass
+  // and the gather sweep weights ΔJ by it.
+  double averaging_weight(std::size_t p, bool damage) const {
+    return particles_.mass[p] * (damage ? softening_[p] : 1.0);
+  }
   template <bool Plastic>
   void update_all_particles();
   // 2D: the same update over a block of particles at a time (simulation.cpp).
@@ -186,6 +192,7 @@ class Simulation {
   std::vector<Stage> stage_fns_;
   std::vector<StageStats> stages_;
   std::vector<std::string> particle_effects_;
+  ParticleTail tail_effects_;  // which of them the scene has (the drive's place is per step)
   // The summary the update sweep reduced, for the time step of the same step (steps_ then);
   // stale once the outflow has removed particles.
   StepSummary summary_;
