@@ -3,6 +3,7 @@
 // (Hu et al. 2018, ACM TOG 37(4) 150). For a particle at grid coordinate xi = x/dx the three
 // nodes are base, base+1, base+2 with base = floor(xi − 0.5).
 #include <array>
+#include <cstddef>
 #include <cmath>
 
 #include "engine/fast_math.hpp"
@@ -68,5 +69,38 @@ inline void for_each_stencil_node(const StencilWeights<Dim>& s, F&& f) {
           f(IVec<3>(i, j, k), s.w[0][i] * s.w[1][j] * s.w[2][k]);
   }
 }
+
+// The same, with each node's flat grid index: f0 is the base node's, stride the grid's flat
+// strides (Grid::strides). Calls f(offset, flat index, weight), in the order above. The callers
+// hoist what depends on one axis only (the node's distance along it), out of the 3^Dim nodes.
+template <int Dim, class F>
+inline void for_each_stencil_node(const StencilWeights<Dim>& s, std::size_t f0,
+                                  const std::array<std::size_t, Dim>& stride, F&& f) {
+  if constexpr (Dim == 2) {
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        f(IVec<2>(i, j), f0 + static_cast<std::size_t>(i) * stride[0] + static_cast<std::size_t>(j),
+          s.w[0][i] * s.w[1][j]);
+  } else {
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        for (int k = 0; k < 3; ++k)
+          f(IVec<3>(i, j, k),
+            f0 + static_cast<std::size_t>(i) * stride[0] + static_cast<std::size_t>(j) * stride[1] +
+                static_cast<std::size_t>(k),
+            s.w[0][i] * s.w[1][j] * s.w[2][k]);
+  }
+}
+
+// Each stencil node's distance from the particle along each axis, (base_a + i − xg_a)·dx, as
+// the per-node form (node − xg)·dx computes it: the same doubles, once per axis and node column.
+template <int Dim>
+struct StencilOffsets {
+  double d[Dim][3];
+  StencilOffsets(const StencilWeights<Dim>& s, const Vec<Dim>& xg, double dx) {
+    for (int a = 0; a < Dim; ++a)
+      for (int i = 0; i < 3; ++i) d[a][i] = (static_cast<double>(s.b[a] + i) - xg[a]) * dx;
+  }
+};
 
 }  // namespace crevasse

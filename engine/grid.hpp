@@ -2,6 +2,8 @@
 // Dense background grid over a box of lattice nodes [lo, lo + n). Node (i, j[, k]) sits at
 // (i, j[, k])·dx. The box is re-fitted to the particles every step, so empty air and rock
 // cost nothing. Flattening is x-slowest, which keeps an x-slab of nodes contiguous.
+#include <array>
+#include <cstddef>
 #include <vector>
 
 #include "engine/types.hpp"
@@ -34,6 +36,14 @@ struct Grid {
     std::size_t f = 0;
     for (int a = 0; a < Dim; ++a) f = f * n[a] + static_cast<std::size_t>(node[a] - lo[a]);
     return f;
+  }
+  // Flat strides per axis (x slowest: the last axis has stride 1), so that node base + off has
+  // the flat index flat(base) + Σ off[a]·stride[a] (the stencil loops of simulation.cpp).
+  std::array<std::size_t, Dim> strides() const {
+    std::array<std::size_t, Dim> s{};
+    s[Dim - 1] = 1;
+    for (int a = Dim - 2; a >= 0; --a) s[a] = s[a + 1] * static_cast<std::size_t>(n[a + 1]);
+    return s;
   }
   IVec<Dim> node_of(std::size_t f) const {
     IVec<Dim> node;

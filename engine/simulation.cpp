@@ -482,27 +482,46 @@ void Simulation<Dim>::scatter_to_grid() {
   const bool plastic = Average && !P.eps_v_p.empty();
   const bool damage = Average && averaging_weights_damage();
   softening_.resize(plastic ? P.size() : 0);
+  const std::array<std::size_t, Dim> stride = grid_.strides();
+  GridNode<Dim>* const nodes = grid_.nodes.data();
   for_each_particle_coloured([&](std::uint32_t p) __attribute__((always_inline)) {
     const Vec<Dim> xg = P.x[p] * inv_dx;
     const StencilWeights<Dim> w(xg);
-    const IVec<Dim> base = w.base();
+    const double m = P.mass[p];
     // MLS-MPM (Hu et al. 2018): stress enters as an affine momentum term,
     // −dt·V0·τ·D⁻¹ with D⁻¹ = 4/dx² for quadratic B-splines.
-    const Mat<Dim> affine = P.mass[p] * P.C[p] - (dt * d_inv * P.vol0[p]) * P.tau[p];
-    const Vec<Dim> mv = P.mass[p] * P.v[p];
+    const Mat<Dim> affine = m * P.C[p] - (dt * d_inv * P.vol0[p]) * P.tau[p];
+    const Vec<Dim> mv = m * P.v[p];
     double wm = 0.0;
     if constexpr (Average) {
       const double f = plastic ? softening_factor(plastic_, P.eps_v_p[p]) : 1.0;
       if (plastic) softening_[p] = f;
       wm = averaging_weight(p, damage);
     }
-    for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
-      const IVec<Dim> node = base + off;
-      const Vec<Dim> dpos = (node.template cast<double>() - xg) * dx;
-      GridNode<Dim>& g = grid_.nodes[grid_.flat(node)];
-      g.mass += wt * P.mass[p];
+    // affine·Δx of a node is Σ_a affine.col(a)·Δx_a: each axis's products depend on the
+    // node's offset along that axis only, so they are formed once per axis (the same doubles)
+    // and summed per node in the order of Eigen's 2×2 and 3×3 products, which the results
+    // were computed with before (bench/state_hash): (p0 + p1) in 2D; in 3D (p0 + p1) + p2 for
+    // the first two rows (one packet) and p0 + (p1 + p2) for the third.
+    const StencilOffsets<Dim> d(w, xg, dx);
+    Vec<Dim> term[Dim][3];
+    for (int a = 0; a < Dim; ++a)
+      for (int i = 0; i < 3; ++i) term[a][i] = affine.col(a) * d.d[a][i];
+    for_each_stencil_node<Dim>(w, grid_.flat(w.base()), stride,
+                               [&](const IVec<Dim>& off, std::size_t f, double wt) {
+      GridNode<Dim>& g = nodes[f];
+      g.mass += wt * m;
       if constexpr (Average) g.intact_mass += wt * wm;
-      g.vel += wt * (mv + affine * dpos);
+      Vec<Dim> ad;
+      if constexpr (Dim == 2) {
+        ad = term[0][off[0]] + term[1][off[1]];
+      } else {
+        const Vec<3>&t0 = term[0][off[0]], &t1 = term[1][off[1]], &t2 = term[2][off[2]];
+        ad[0] = (t0[0] + t1[0]) + t2[0];
+        ad[1] = (t0[1] + t1[1]) + t2[1];
+        ad[2] = t0[2] + (t1[2] + t2[2]);
+      }
+      g.vel += wt * (mv + ad);
     });
   });
 }
@@ -626,21 +645,35 @@ template <int Dim>
   // ones, in the same order: v_i += w·v_node,i and B_ij += (w·v_node,i)·Δx_j.
   auto& P = particles_;
   const double dx = scene_.dx, inv_dx = 1.0 / dx;
-  const IVec<Dim> base = w.base();
+  const StencilOffsets<Dim> d(w, xg, dx);
+  const GridNode<Dim>* const nodes = grid_.nodes.data();
+  const double scale = 4.0 * inv_dx * inv_dx;
+  if constexpr (Dim == 2) {
+    // In 2D the same sums on (x, y) pairs, one vector register each: v, and the columns of B.
+    Vec<2> v = Vec<2>::Zero(), b0 = Vec<2>::Zero(), b1 = Vec<2>::Zero();
+    for_each_stencil_node<2>(w, grid_.flat(w.base()), grid_.strides(),
+                             [&](const IVec<2>& off, std::size_t f, double wt) {
+      const Vec<2> wv = wt * nodes[f].vel;
+      v += wv;
+      b0 += wv * d.d[0][off[0]];
+      b1 += wv * d.d[1][off[1]];
+    });
+    P.v[p] = v;
+    P.C[p].col(0) = scale * b0;
+    P.C[p].col(1) = scale * b1;
+    return;
+  }
   double v[Dim] = {};
   double b[Dim][Dim] = {};
-  for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
-    const IVec<Dim> node = base + off;
-    double dpos[Dim];
-    for (int j = 0; j < Dim; ++j) dpos[j] = (static_cast<double>(node[j]) - xg[j]) * dx;
-    const Vec<Dim>& vi = grid_.nodes[grid_.flat(node)].vel;
+  for_each_stencil_node<Dim>(w, grid_.flat(w.base()), grid_.strides(),
+                             [&](const IVec<Dim>& off, std::size_t f, double wt) {
+    const Vec<Dim>& vi = nodes[f].vel;
     for (int i = 0; i < Dim; ++i) {
       const double wv = wt * vi[i];
       v[i] += wv;
-      for (int j = 0; j < Dim; ++j) b[i][j] += wv * dpos[j];
+      for (int j = 0; j < Dim; ++j) b[i][j] += wv * d.d[j][off[j]];
     }
   });
-  const double scale = 4.0 * inv_dx * inv_dx;
   for (int i = 0; i < Dim; ++i) {
     P.v[p][i] = v[i];
     for (int j = 0; j < Dim; ++j) P.C[p](i, j) = scale * b[i][j];
@@ -768,16 +801,16 @@ void Simulation<Dim>::gather_velocities_and_scatter_volume() {
   const double inv_dx = 1.0 / scene_.dx;
   const bool damage = averaging_weights_damage();
   grid_aux_.assign(2 * grid_.node_count(), 0.0);  // per node Σ w m (1−D) ΔJ, then (ΔJ̄, has one)
+  double* const aux = grid_aux_.data();
+  const std::array<std::size_t, Dim> stride = grid_.strides();
   for_each_particle_coloured([&](std::uint32_t p) __attribute__((always_inline)) {
     const Vec<Dim> xg = P.x[p] * inv_dx;
     const StencilWeights<Dim> w(xg);
     gather_velocity(p, w, xg);
     const double dj = (Mat<Dim>::Identity() + dt_ * P.C[p]).determinant();
     const double wm = averaging_weight(p, damage);  // the weight P2G added to intact_mass
-    const IVec<Dim> base = w.base();
-    for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
-      grid_aux_[2 * grid_.flat(base + off)] += wt * wm * dj;
-    });
+    for_each_stencil_node<Dim>(w, grid_.flat(w.base()), stride,
+                               [&](const IVec<Dim>&, std::size_t f, double wt) { aux[2 * f] += wt * wm * dj; });
   });
 }
 
@@ -800,13 +833,16 @@ template <int Dim>
     std::size_t p, const StencilWeights<Dim>& w) const {
   // The stencil's Σ w ΔJ̄ and Σ w over the nodes that carry an average, from the normalised
   // grid_aux_, and ΔJ_p of particle p (before its update moves it).
-  const IVec<Dim> base = w.base();
+  const double* const aux = grid_aux_.data();
   VolumeSums v{0.0, 0.0, 0.0};
-  for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
-    const std::size_t f = 2 * grid_.flat(base + off);
-    v.jbar += wt * grid_aux_[f];
-    v.wsum += wt * grid_aux_[f + 1];
+  // (Σ w ΔJ̄, Σ w) as one pair: each node's two slots are adjacent, one vector load.
+  Vec<2> sums = Vec<2>::Zero();
+  for_each_stencil_node<Dim>(w, grid_.flat(w.base()), grid_.strides(),
+                             [&](const IVec<Dim>&, std::size_t f, double wt) {
+    sums += wt * Eigen::Map<const Vec<2>>(aux + 2 * f);
   });
+  v.jbar = sums[0];
+  v.wsum = sums[1];
   v.dj = (Mat<Dim>::Identity() + dt_ * particles_.C[p]).determinant();
   return v;
 }

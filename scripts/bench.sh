@@ -23,8 +23,8 @@ mkdir -p "$build"
 } >"$log" 2>&1 || { cat "$log" >&2; echo "bench.sh: build failed" >&2; exit 1; }
 
 load_before=$(cut -d' ' -f1-3 /proc/loadavg)
-# Interleaved rounds: per round and group (dimension, thread count), the limit kernel and then
-# the engine's cases, one repetition each, so that a drift of the machine's speed divides out of
+# Interleaved rounds: per round and group (dimension, thread count), the limit kernel (alone and
+# with the ΔJ-bar average) and then the engine's cases, one repetition each, so that a drift of the machine's speed divides out of
 # the fraction of the limit (bench_table.py takes each round's ratio).
 out="$build/bench-rounds"
 rm -rf "$out"
@@ -37,7 +37,7 @@ for r in $(seq "$reps"); do
   for dim in 2d 3d; do
     for t in 1 2; do
       [[ "$dim/threads:$t" =~ $filter ]] || continue
-      run bench_limit "^limit/$dim/threads:$t/" "limit_${r}_${dim}_$t.json"
+      run bench_limit "^limit(_averaging)?/$dim/threads:$t/" "limit_${r}_${dim}_$t.json"
       run bench_step "^step/$dim/[a-z]+/threads:$t/" "step_${r}_${dim}_$t.json"
     done
   done
