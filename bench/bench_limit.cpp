@@ -175,8 +175,9 @@ class LimitKernel {
         for (int i = 0; i < 3; ++i) term[a][i] = affine.col(a) * d.d[a][i];
       for_each_stencil_node<Dim>(w, flat(w.base()), stride_,
                                  [&](const IVec<Dim>& off, std::size_t f, double wt) {
-        Vec<Dim> ad = term[0][off[0]] + term[1][off[1]];
-        if constexpr (Dim == 3) ad += term[2][off[2]];
+        Vec<Dim> ad;
+        if constexpr (Dim == 2) ad = product_from_columns(term[0][off[0]], term[1][off[1]]);
+        else ad = product_from_columns(term[0][off[0]], term[1][off[1]], term[2][off[2]]);
         Node& g = grid_[f];
         g[0] += wt * m;
         g.template tail<Dim>() += wt * (mv + ad);

@@ -103,4 +103,15 @@ struct StencilOffsets {
   }
 };
 
+// A small matrix–vector product A·Δx from its column products t_a = A.col(a)·Δx_a, summed in
+// the order in which Eigen's fixed-size product sums them in the project's build (SSE2, no
+// FMA), so the result is the same double: t0 + t1 in 2D; in 3D (t0 + t1) + t2 for the first two
+// rows (one SSE2 packet) and t0 + (t1 + t2) for the third. P2G forms the products once per axis
+// and node column and sums them per node (simulation.cpp); tests/engine/test_bspline.cpp checks
+// the order against Eigen's product.
+inline Vec<2> product_from_columns(const Vec<2>& t0, const Vec<2>& t1) { return t0 + t1; }
+inline Vec<3> product_from_columns(const Vec<3>& t0, const Vec<3>& t1, const Vec<3>& t2) {
+  return Vec<3>((t0[0] + t1[0]) + t2[0], (t0[1] + t1[1]) + t2[1], t0[2] + (t1[2] + t2[2]));
+}
+
 }  // namespace crevasse

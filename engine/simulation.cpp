@@ -500,9 +500,8 @@ void Simulation<Dim>::scatter_to_grid() {
     }
     // affine·Δx of a node is Σ_a affine.col(a)·Δx_a: each axis's products depend on the
     // node's offset along that axis only, so they are formed once per axis (the same doubles)
-    // and summed per node in the order of Eigen's 2×2 and 3×3 products, which the results
-    // were computed with before (bench/state_hash): (p0 + p1) in 2D; in 3D (p0 + p1) + p2 for
-    // the first two rows (one packet) and p0 + (p1 + p2) for the third.
+    // and summed per node in the order of Eigen's product, which the results were computed
+    // with before (product_from_columns; bench/state_hash).
     const StencilOffsets<Dim> d(w, xg, dx);
     Vec<Dim> term[Dim][3];
     for (int a = 0; a < Dim; ++a)
@@ -513,14 +512,8 @@ void Simulation<Dim>::scatter_to_grid() {
       g.mass += wt * m;
       if constexpr (Average) g.intact_mass += wt * wm;
       Vec<Dim> ad;
-      if constexpr (Dim == 2) {
-        ad = term[0][off[0]] + term[1][off[1]];
-      } else {
-        const Vec<3>&t0 = term[0][off[0]], &t1 = term[1][off[1]], &t2 = term[2][off[2]];
-        ad[0] = (t0[0] + t1[0]) + t2[0];
-        ad[1] = (t0[1] + t1[1]) + t2[1];
-        ad[2] = t0[2] + (t1[2] + t2[2]);
-      }
+      if constexpr (Dim == 2) ad = product_from_columns(term[0][off[0]], term[1][off[1]]);
+      else ad = product_from_columns(term[0][off[0]], term[1][off[1]], term[2][off[2]]);
       g.vel += wt * (mv + ad);
     });
   });

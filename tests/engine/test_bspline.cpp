@@ -9,6 +9,7 @@
 #include <random>
 
 #include "engine/bspline.hpp"
+#include "engine/grid.hpp"
 
 namespace crevasse {
 namespace {
@@ -95,6 +96,83 @@ TEST(BSpline, WeightsAtNodesAndCellCentres) {
   EXPECT_DOUBLE_EQ(centre.w[0], 0.5);
   EXPECT_DOUBLE_EQ(centre.w[1], 0.5);
   EXPECT_DOUBLE_EQ(centre.w[2], 0.0);
+}
+
+// The flat-index stencil loop visits the same nodes, in the same order and with the same
+// weights, as the per-node loop with Grid::flat; StencilOffsets gives the same doubles as the
+// per-node distance (node − x/dx)·dx. The stencil loops of simulation.cpp rest on both.
+template <int Dim>
+void check_flat_stencil(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> pos(-40.0, 40.0);
+  Grid<Dim> grid;
+  grid.dx = 2.5;
+  IVec<Dim> lo, n;
+  for (int a = 0; a < Dim; ++a) {
+    lo[a] = -20 - a;  // the box covers every stencil of |x/dx| ≤ 16
+    n[a] = 45 + 3 * a;
+  }
+  grid.reset(lo, n);
+  const auto stride = grid.strides();
+  for (int trial = 0; trial < 2000; ++trial) {
+    Vec<Dim> xg;
+    for (int a = 0; a < Dim; ++a) xg[a] = pos(rng) / grid.dx;
+    const StencilWeights<Dim> w(xg);
+    const StencilOffsets<Dim> d(w, xg, grid.dx);
+    std::vector<std::pair<std::size_t, double>> by_node, by_flat;
+    std::vector<double> dist_node, dist_flat;
+    for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
+      const IVec<Dim> node = w.base() + off;
+      by_node.emplace_back(grid.flat(node), wt);
+      for (int a = 0; a < Dim; ++a)
+        dist_node.push_back(((node.template cast<double>() - xg) * grid.dx)[a]);
+    });
+    for_each_stencil_node<Dim>(w, grid.flat(w.base()), stride,
+                               [&](const IVec<Dim>& off, std::size_t f, double wt) {
+      by_flat.emplace_back(f, wt);
+      for (int a = 0; a < Dim; ++a) dist_flat.push_back(d.d[a][off[a]]);
+    });
+    ASSERT_EQ(by_node, by_flat) << "trial " << trial;
+    ASSERT_EQ(dist_node, dist_flat) << "trial " << trial;  // bit for bit
+  }
+}
+
+TEST(BSpline, FlatIndexStencilVisitsTheSameNodesWithTheSameWeightsAndDistances) {
+  std::mt19937_64 rng(11);
+  check_flat_stencil<2>(rng);
+  check_flat_stencil<3>(rng);
+}
+
+// product_from_columns sums the column products of A·Δx in the order of Eigen's fixed-size
+// product, so P2G's per-axis form gives the results of A * Δx to the bit (without FMA, the
+// project's build; with -march=native the compiler may fuse either side's multiply-adds, so
+// there the two agree to round-off only). A change of Eigen's evaluation order fails here.
+template <int Dim>
+void check_product_order(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int differ = 0;
+  for (int trial = 0; trial < 200000; ++trial) {
+    Mat<Dim> a;
+    Vec<Dim> dx;
+    for (int i = 0; i < Dim * Dim; ++i) a.data()[i] = 1e6 * u(rng);
+    for (int i = 0; i < Dim; ++i) dx[i] = 30.0 * u(rng);
+    const Vec<Dim> eigen = a * dx;
+    Vec<Dim> ours;
+    if constexpr (Dim == 2) ours = product_from_columns(Vec<2>(a.col(0) * dx[0]), Vec<2>(a.col(1) * dx[1]));
+    else ours = product_from_columns(Vec<3>(a.col(0) * dx[0]), Vec<3>(a.col(1) * dx[1]), Vec<3>(a.col(2) * dx[2]));
+    for (int i = 0; i < Dim; ++i) {
+      ASSERT_NEAR(ours[i], eigen[i], 1e-9 * (a.row(i).cwiseAbs() * dx.cwiseAbs()).sum());
+      differ += ours[i] != eigen[i];
+    }
+  }
+#ifndef __FMA__
+  EXPECT_EQ(differ, 0) << Dim << "D: components that differ from Eigen's product in the last bits";
+#endif
+}
+
+TEST(BSpline, ProductFromColumnsIsEigensProductToTheBit) {
+  std::mt19937_64 rng(13);
+  check_product_order<2>(rng);
+  check_product_order<3>(rng);
 }
 
 }  // namespace
