@@ -100,6 +100,7 @@ class LimitKernel {
       slab_begin_[static_cast<std::size_t>(s)] = p;
     }
     dt_ = cfl_ * dx_ / p_wave_speed_;
+    d_inv_ = 4.0 / (dx_ * dx_);
   }
 
   std::size_t size() const { return x_.size(); }
@@ -161,26 +162,18 @@ class LimitKernel {
 
   void particle_to_grid() {
     const double inv_dx = 1.0 / dx_;
-    const double d_inv = 4.0 * inv_dx * inv_dx;
     for_each_coloured([&](std::size_t p) {
       const Vec<Dim> xg = x_[p] * inv_dx;
       const StencilWeights<Dim> w(xg);
       const double m = mass_[p];
-      const Mat<Dim> affine = m * C_[p] - (dt_ * d_inv * vol0_[p]) * tau_[p];
+      const Mat<Dim> affine = m * C_[p] - (dt_ * d_inv_ * vol0_[p]) * tau_[p];
       const Vec<Dim> mv = m * v_[p];
-      // affine·Δx per node from per-axis products, as the engine's P2G forms it.
-      const StencilOffsets<Dim> d(w, xg, dx_);
-      Vec<Dim> term[Dim][3];
-      for (int a = 0; a < Dim; ++a)
-        for (int i = 0; i < 3; ++i) term[a][i] = affine.col(a) * d.d[a][i];
+      const AffineTerms<Dim> ad(affine, StencilOffsets<Dim>(w, xg, dx_));  // as the engine's P2G
       for_each_stencil_node<Dim>(w, flat(w.base()), stride_,
                                  [&](const IVec<Dim>& off, std::size_t f, double wt) {
-        Vec<Dim> ad;
-        if constexpr (Dim == 2) ad = product_from_columns(term[0][off[0]], term[1][off[1]]);
-        else ad = product_from_columns(term[0][off[0]], term[1][off[1]], term[2][off[2]]);
         Node& g = grid_[f];
         g[0] += wt * m;
-        g.template tail<Dim>() += wt * (mv + ad);
+        g.template tail<Dim>() += wt * (mv + ad.at(off));
       });
     });
   }
@@ -197,40 +190,12 @@ class LimitKernel {
   }
 
   // Gathers v and C of particle p (at grid coordinate xg, weights w) from the grid, as the
-  // engine gathers: in 2D (x, y) pairs in vector registers; in 3D scalar accumulators (Eigen's
-  // outer-product temporaries of 3-vectors go through the stack and stall on store
-  // forwarding, 3× slower).
+  // engine gathers (gather_apic).
   void gather(const StencilWeights<Dim>& w, const Vec<Dim>& xg, Vec<Dim>& vel, Mat<Dim>& c) const {
-    const double d_inv = 4.0 / (dx_ * dx_);
-    const StencilOffsets<Dim> d(w, xg, dx_);
-    if constexpr (Dim == 2) {
-      Vec<2> v = Vec<2>::Zero(), b0 = Vec<2>::Zero(), b1 = Vec<2>::Zero();
-      for_each_stencil_node<2>(w, flat(w.base()), stride_,
-                               [&](const IVec<2>& off, std::size_t f, double wt) {
-        const Vec<2> wv = wt * grid_[f].template tail<2>();
-        v += wv;
-        b0 += wv * d.d[0][off[0]];
-        b1 += wv * d.d[1][off[1]];
-      });
-      vel = v;
-      c.col(0) = d_inv * b0;
-      c.col(1) = d_inv * b1;
-    } else {
-      std::array<double, Dim> v{};
-      std::array<double, Dim * Dim> b{};
-      for_each_stencil_node<Dim>(w, flat(w.base()), stride_,
-                                 [&](const IVec<Dim>& off, std::size_t f, double wt) {
-        const Node& g = grid_[f];
-        for (int a = 0; a < Dim; ++a) {
-          const double wv = wt * g[a + 1];
-          v[a] += wv;
-          for (int k = 0; k < Dim; ++k) b[a * Dim + k] += wv * d.d[k][off[k]];
-        }
-      });
-      for (int a = 0; a < Dim; ++a)
-        for (int k = 0; k < Dim; ++k) c(a, k) = d_inv * b[a * Dim + k];
-      vel = Eigen::Map<const Vec<Dim>>(v.data());
-    }
+    Mat<Dim> b;
+    gather_apic<Dim>(w, StencilOffsets<Dim>(w, xg, dx_), flat(w.base()), stride_,
+                     [this](std::size_t f) { return grid_[f].template tail<Dim>(); }, vel, b);
+    c = d_inv_ * b;
   }
 
   // Moves particle p and writes its F and τ: a linear stand-in for the stress,
@@ -309,6 +274,7 @@ class LimitKernel {
   double dx_, cfl_, p_wave_speed_;
   ElasticModuli moduli_;
   double dt_ = 0.0;
+  double d_inv_ = 0.0;  // 4/dx², the MLS inertia's inverse
   Vec<Dim> gravity_ = Vec<Dim>::Zero();
   std::vector<Vec<Dim>> x_, v_;
   std::vector<Mat<Dim>> C_, F_, tau_;

@@ -103,15 +103,67 @@ struct StencilOffsets {
   }
 };
 
-// A small matrix–vector product A·Δx from its column products t_a = A.col(a)·Δx_a, summed in
-// the order in which Eigen's fixed-size product sums them in the project's build (SSE2, no
-// FMA), so the result is the same double: t0 + t1 in 2D; in 3D (t0 + t1) + t2 for the first two
-// rows (one SSE2 packet) and t0 + (t1 + t2) for the third. P2G forms the products once per axis
-// and node column and sums them per node (simulation.cpp); tests/engine/test_bspline.cpp checks
-// the order against Eigen's product.
-inline Vec<2> product_from_columns(const Vec<2>& t0, const Vec<2>& t1) { return t0 + t1; }
-inline Vec<3> product_from_columns(const Vec<3>& t0, const Vec<3>& t1, const Vec<3>& t2) {
-  return Vec<3>((t0[0] + t1[0]) + t2[0], (t0[1] + t1[1]) + t2[1], t0[2] + (t1[2] + t2[2]));
+// A·Δx for every node of a stencil (P2G's affine momentum term), from the column products
+// t_a,i = A.col(a)·Δx_a,i formed once per axis and node column (3·Dim products instead of one
+// matrix–vector product per node), summed per node in the order in which Eigen's fixed-size
+// product A * Δx sums them in the project's build (SSE2, no FMA), so each node gets the same
+// double: t0 + t1 in 2D; in 3D (t0 + t1) + t2 for the first two rows (one SSE2 packet) and
+// t0 + (t1 + t2) for the third. tests/engine/test_bspline.cpp compares it with A * Δx.
+template <int Dim>
+struct AffineTerms {
+  Vec<Dim> t[Dim][3];
+  AffineTerms(const Mat<Dim>& a, const StencilOffsets<Dim>& d) {
+    for (int ax = 0; ax < Dim; ++ax)
+      for (int i = 0; i < 3; ++i) t[ax][i] = a.col(ax) * d.d[ax][i];
+  }
+  Vec<Dim> at(const IVec<Dim>& off) const {
+    const Vec<Dim>&t0 = t[0][off[0]], &t1 = t[1][off[1]];
+    if constexpr (Dim == 2) {
+      return t0 + t1;
+    } else {
+      const Vec<3>& t2 = t[2][off[2]];
+      return Vec<3>((t0[0] + t1[0]) + t2[0], (t0[1] + t1[1]) + t2[1], t0[2] + (t1[2] + t2[2]));
+    }
+  }
+};
+
+// The APIC/MLS gather of one particle: v = Σ w v_i and B = Σ w v_i Δxᵀ over its stencil (C is
+// 4/dx² B for quadratic B-splines), node velocities from vel(flat index). The products and sums
+// per component are v_a += w·v_i,a and B_ab += (w·v_i,a)·Δx_b in node order. In 2D on (x, y)
+// pairs, one vector register each for v and the columns of B (g++ 12 leaves the scalar form
+// scalar); in 3D in scalar accumulators (Eigen's outer product of 3-vectors goes through stack
+// temporaries and stalls on store-to-load forwarding: docs/performance.md).
+template <int Dim, class Vel>
+inline void gather_apic(const StencilWeights<Dim>& w, const StencilOffsets<Dim>& d, std::size_t f0,
+                        const std::array<std::size_t, Dim>& stride, Vel&& vel, Vec<Dim>& v_out,
+                        Mat<Dim>& b_out) {
+  if constexpr (Dim == 2) {
+    Vec<2> v = Vec<2>::Zero(), b0 = Vec<2>::Zero(), b1 = Vec<2>::Zero();
+    for_each_stencil_node<2>(w, f0, stride, [&](const IVec<2>& off, std::size_t f, double wt) {
+      const Vec<2> wv = wt * vel(f);
+      v += wv;
+      b0 += wv * d.d[0][off[0]];
+      b1 += wv * d.d[1][off[1]];
+    });
+    v_out = v;
+    b_out.col(0) = b0;
+    b_out.col(1) = b1;
+  } else {
+    double v[Dim] = {};
+    double b[Dim][Dim] = {};
+    for_each_stencil_node<Dim>(w, f0, stride, [&](const IVec<Dim>& off, std::size_t f, double wt) {
+      const auto& vi = vel(f);
+      for (int a = 0; a < Dim; ++a) {
+        const double wv = wt * vi[a];
+        v[a] += wv;
+        for (int k = 0; k < Dim; ++k) b[a][k] += wv * d.d[k][off[k]];
+      }
+    });
+    for (int a = 0; a < Dim; ++a) {
+      v_out[a] = v[a];
+      for (int k = 0; k < Dim; ++k) b_out(a, k) = b[a][k];
+    }
+  }
 }
 
 }  // namespace crevasse

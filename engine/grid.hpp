@@ -26,6 +26,7 @@ struct Grid {
   IVec<Dim> lo = IVec<Dim>::Zero();
   IVec<Dim> n = IVec<Dim>::Zero();
   std::vector<GridNode<Dim>> nodes;
+  std::array<std::size_t, Dim> stride{};  // strides(); set with the box by reset()
 
   std::size_t node_count() const {
     std::size_t c = 1;
@@ -38,13 +39,9 @@ struct Grid {
     return f;
   }
   // Flat strides per axis (x slowest: the last axis has stride 1), so that node base + off has
-  // the flat index flat(base) + Σ off[a]·stride[a] (the stencil loops of simulation.cpp).
-  std::array<std::size_t, Dim> strides() const {
-    std::array<std::size_t, Dim> s{};
-    s[Dim - 1] = 1;
-    for (int a = Dim - 2; a >= 0; --a) s[a] = s[a + 1] * static_cast<std::size_t>(n[a + 1]);
-    return s;
-  }
+  // the flat index flat(base) + Σ off[a]·stride[a] (the stencil loops of simulation.cpp). Set
+  // by reset(), with the box.
+  const std::array<std::size_t, Dim>& strides() const { return stride; }
   IVec<Dim> node_of(std::size_t f) const {
     IVec<Dim> node;
     for (int a = Dim - 1; a >= 0; --a) {
@@ -58,6 +55,8 @@ struct Grid {
   void reset(const IVec<Dim>& new_lo, const IVec<Dim>& new_n) {
     lo = new_lo;
     n = new_n;
+    stride[Dim - 1] = 1;
+    for (int a = Dim - 2; a >= 0; --a) stride[a] = stride[a + 1] * static_cast<std::size_t>(n[a + 1]);
     nodes.assign(node_count(), GridNode<Dim>{});
   }
 };

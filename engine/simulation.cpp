@@ -498,23 +498,14 @@ void Simulation<Dim>::scatter_to_grid() {
       if (plastic) softening_[p] = f;
       wm = averaging_weight(p, damage);
     }
-    // affine·Δx of a node is Σ_a affine.col(a)·Δx_a: each axis's products depend on the
-    // node's offset along that axis only, so they are formed once per axis (the same doubles)
-    // and summed per node in the order of Eigen's product, which the results were computed
-    // with before (product_from_columns; bench/state_hash).
-    const StencilOffsets<Dim> d(w, xg, dx);
-    Vec<Dim> term[Dim][3];
-    for (int a = 0; a < Dim; ++a)
-      for (int i = 0; i < 3; ++i) term[a][i] = affine.col(a) * d.d[a][i];
+    // affine·Δx per node from per-axis products, the doubles of affine * Δx (AffineTerms).
+    const AffineTerms<Dim> ad(affine, StencilOffsets<Dim>(w, xg, dx));
     for_each_stencil_node<Dim>(w, grid_.flat(w.base()), stride,
                                [&](const IVec<Dim>& off, std::size_t f, double wt) {
       GridNode<Dim>& g = nodes[f];
       g.mass += wt * m;
       if constexpr (Average) g.intact_mass += wt * wm;
-      Vec<Dim> ad;
-      if constexpr (Dim == 2) ad = product_from_columns(term[0][off[0]], term[1][off[1]]);
-      else ad = product_from_columns(term[0][off[0]], term[1][off[1]], term[2][off[2]]);
-      g.vel += wt * (mv + ad);
+      g.vel += wt * (mv + ad.at(off));
     });
   });
 }
@@ -630,47 +621,19 @@ void Simulation<Dim>::apply_velocity_boxes_to_grid() {
 }
 
 template <int Dim>
-[[gnu::always_inline]] inline void Simulation<Dim>::gather_velocity(std::size_t p, const StencilWeights<Dim>& w, const Vec<Dim>& xg) {
-  // APIC/MLS gather of the particle velocity and its affine matrix C from the grid, with the
-  // stencil weights w of the particle at grid coordinate xg = x/dx. Accumulated in scalars:
-  // Eigen's outer product of small vectors went through stack temporaries and stalled on
-  // store-to-load forwarding (docs/performance.md, 3D); the products and sums are the same
-  // ones, in the same order: v_i += w·v_node,i and B_ij += (w·v_node,i)·Δx_j.
-  auto& P = particles_;
-  const double dx = scene_.dx, inv_dx = 1.0 / dx;
-  const StencilOffsets<Dim> d(w, xg, dx);
+[[gnu::always_inline]] inline void Simulation<Dim>::gather_velocity(std::size_t p, const StencilWeights<Dim>& w,
+                                                                    const StencilOffsets<Dim>& d, std::size_t f0,
+                                                                    double c_scale) {
+  // APIC/MLS gather of the particle velocity and its affine matrix C = c_scale·B (c_scale =
+  // 4/dx², formed once by the caller) from the grid (gather_apic); f0 = flat index of the
+  // stencil's base node.
   const GridNode<Dim>* const nodes = grid_.nodes.data();
-  const double scale = 4.0 * inv_dx * inv_dx;
-  if constexpr (Dim == 2) {
-    // In 2D the same sums on (x, y) pairs, one vector register each: v, and the columns of B.
-    Vec<2> v = Vec<2>::Zero(), b0 = Vec<2>::Zero(), b1 = Vec<2>::Zero();
-    for_each_stencil_node<2>(w, grid_.flat(w.base()), grid_.strides(),
-                             [&](const IVec<2>& off, std::size_t f, double wt) {
-      const Vec<2> wv = wt * nodes[f].vel;
-      v += wv;
-      b0 += wv * d.d[0][off[0]];
-      b1 += wv * d.d[1][off[1]];
-    });
-    P.v[p] = v;
-    P.C[p].col(0) = scale * b0;
-    P.C[p].col(1) = scale * b1;
-    return;
-  }
-  double v[Dim] = {};
-  double b[Dim][Dim] = {};
-  for_each_stencil_node<Dim>(w, grid_.flat(w.base()), grid_.strides(),
-                             [&](const IVec<Dim>& off, std::size_t f, double wt) {
-    const Vec<Dim>& vi = nodes[f].vel;
-    for (int i = 0; i < Dim; ++i) {
-      const double wv = wt * vi[i];
-      v[i] += wv;
-      for (int j = 0; j < Dim; ++j) b[i][j] += wv * d.d[j][off[j]];
-    }
-  });
-  for (int i = 0; i < Dim; ++i) {
-    P.v[p][i] = v[i];
-    for (int j = 0; j < Dim; ++j) P.C[p](i, j) = scale * b[i][j];
-  }
+  Vec<Dim> v;
+  Mat<Dim> b;
+  gather_apic<Dim>(w, d, f0, grid_.strides(),
+                   [nodes](std::size_t f) -> const Vec<Dim>& { return nodes[f].vel; }, v, b);
+  particles_.v[p] = v;
+  particles_.C[p] = c_scale * b;
 }
 
 // pow(s, 1/d), the root of a volume ratio; in 2D by pow_half, the same double at less cost.
@@ -753,10 +716,11 @@ void Simulation<Dim>::grid_to_particle() {
   summary_ = tbb::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, P.size(), kGrain), StepSummary{},
       [&](const auto& r, StepSummary acc) {
-        const double inv_dx = 1.0 / scene_.dx;
+        const double dx = scene_.dx, inv_dx = 1.0 / dx, c_scale = 4.0 * inv_dx * inv_dx;
         for (std::size_t p = r.begin(); p != r.end(); ++p) {
           const Vec<Dim> xg = P.x[p] * inv_dx;
-          gather_velocity(p, StencilWeights<Dim>(xg), xg);
+          const StencilWeights<Dim> w(xg);
+          gather_velocity(p, w, StencilOffsets<Dim>(w, xg, dx), grid_.flat(w.base()), c_scale);
           update_particle<Plastic>(p, 1.0, Plastic ? softening_factor(plastic_, P.eps_v_p[p]) : 1.0);
           finish_particle(p, tail, acc);
         }
@@ -791,7 +755,7 @@ bool Simulation<Dim>::averaging_weights_damage() const {
 template <int Dim>
 void Simulation<Dim>::gather_velocities_and_scatter_volume() {
   auto& P = particles_;
-  const double inv_dx = 1.0 / scene_.dx;
+  const double dx = scene_.dx, inv_dx = 1.0 / dx, c_scale = 4.0 * inv_dx * inv_dx;
   const bool damage = averaging_weights_damage();
   grid_aux_.assign(2 * grid_.node_count(), 0.0);  // per node Σ w m (1−D) ΔJ, then (ΔJ̄, has one)
   double* const aux = grid_aux_.data();
@@ -799,10 +763,11 @@ void Simulation<Dim>::gather_velocities_and_scatter_volume() {
   for_each_particle_coloured([&](std::uint32_t p) __attribute__((always_inline)) {
     const Vec<Dim> xg = P.x[p] * inv_dx;
     const StencilWeights<Dim> w(xg);
-    gather_velocity(p, w, xg);
+    const std::size_t f0 = grid_.flat(w.base());
+    gather_velocity(p, w, StencilOffsets<Dim>(w, xg, dx), f0, c_scale);
     const double dj = (Mat<Dim>::Identity() + dt_ * P.C[p]).determinant();
     const double wm = averaging_weight(p, damage);  // the weight P2G added to intact_mass
-    for_each_stencil_node<Dim>(w, grid_.flat(w.base()), stride,
+    for_each_stencil_node<Dim>(w, f0, stride,
                                [&](const IVec<Dim>&, std::size_t f, double wt) { aux[2 * f] += wt * wm * dj; });
   });
 }

@@ -130,7 +130,8 @@ class Simulation {
   void apply_velocity_boxes_to_grid();
   template <bool Plastic>
   void grid_to_particle();  // gather + update fused (no volume averaging)
-  void gather_velocity(std::size_t p, const StencilWeights<Dim>& w, const Vec<Dim>& xg);
+  void gather_velocity(std::size_t p, const StencilWeights<Dim>& w, const StencilOffsets<Dim>& d,
+                       std::size_t f0, double c_scale);
   template <bool Plastic>
   void update_particle(std::size_t p, double volume_scale, double softening);  // softening: e^{−ζ ε_v^p}
   template <bool Plastic>

@@ -98,20 +98,28 @@ TEST(BSpline, WeightsAtNodesAndCellCentres) {
   EXPECT_DOUBLE_EQ(centre.w[2], 0.0);
 }
 
+// A grid box of spacing dx from node lo0 to lo0 + n0 − 1 along every axis (a little longer along
+// the later axes, so that the flat strides differ from the box length).
+template <int Dim>
+Grid<Dim> test_grid(double dx, int lo0, int n0) {
+  Grid<Dim> grid;
+  grid.dx = dx;
+  IVec<Dim> lo, n;
+  for (int a = 0; a < Dim; ++a) {
+    lo[a] = lo0;
+    n[a] = n0 + 3 * a;
+  }
+  grid.reset(lo, n);
+  return grid;
+}
+
 // The flat-index stencil loop visits the same nodes, in the same order and with the same
 // weights, as the per-node loop with Grid::flat; StencilOffsets gives the same doubles as the
 // per-node distance (node − x/dx)·dx. The stencil loops of simulation.cpp rest on both.
 template <int Dim>
 void check_flat_stencil(std::mt19937_64& rng) {
   std::uniform_real_distribution<double> pos(-40.0, 40.0);
-  Grid<Dim> grid;
-  grid.dx = 2.5;
-  IVec<Dim> lo, n;
-  for (int a = 0; a < Dim; ++a) {
-    lo[a] = -20 - a;  // the box covers every stencil of |x/dx| ≤ 16
-    n[a] = 45 + 3 * a;
-  }
-  grid.reset(lo, n);
+  Grid<Dim> grid = test_grid<Dim>(2.5, -20, 45);  // covers every stencil of |x/dx| ≤ 16
   const auto stride = grid.strides();
   for (int trial = 0; trial < 2000; ++trial) {
     Vec<Dim> xg;
@@ -142,37 +150,89 @@ TEST(BSpline, FlatIndexStencilVisitsTheSameNodesWithTheSameWeightsAndDistances) 
   check_flat_stencil<3>(rng);
 }
 
-// product_from_columns sums the column products of A·Δx in the order of Eigen's fixed-size
-// product, so P2G's per-axis form gives the results of A * Δx to the bit (without FMA, the
-// project's build; with -march=native the compiler may fuse either side's multiply-adds, so
-// there the two agree to round-off only). A change of Eigen's evaluation order fails here.
+// AffineTerms gives every node of a stencil the double that P2G's per-node product
+// affine * (node − x/dx)·dx gave before it (the results of every study were computed so), in
+// the project's build (no FMA); with -march=native the compiler may fuse either side's
+// multiply-adds, so there the two agree to round-off only. A change of Eigen's evaluation
+// order, or of the summation order in AffineTerms::at, fails here.
 template <int Dim>
-void check_product_order(std::mt19937_64& rng) {
+void check_affine_terms(std::mt19937_64& rng) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const double dx = 10.0;
   int differ = 0;
-  for (int trial = 0; trial < 200000; ++trial) {
+  for (int trial = 0; trial < 50000; ++trial) {
     Mat<Dim> a;
-    Vec<Dim> dx;
+    Vec<Dim> xg;
     for (int i = 0; i < Dim * Dim; ++i) a.data()[i] = 1e6 * u(rng);
-    for (int i = 0; i < Dim; ++i) dx[i] = 30.0 * u(rng);
-    const Vec<Dim> eigen = a * dx;
-    Vec<Dim> ours;
-    if constexpr (Dim == 2) ours = product_from_columns(Vec<2>(a.col(0) * dx[0]), Vec<2>(a.col(1) * dx[1]));
-    else ours = product_from_columns(Vec<3>(a.col(0) * dx[0]), Vec<3>(a.col(1) * dx[1]), Vec<3>(a.col(2) * dx[2]));
-    for (int i = 0; i < Dim; ++i) {
-      ASSERT_NEAR(ours[i], eigen[i], 1e-9 * (a.row(i).cwiseAbs() * dx.cwiseAbs()).sum());
-      differ += ours[i] != eigen[i];
-    }
+    for (int i = 0; i < Dim; ++i) xg[i] = 300.0 * u(rng);
+    const StencilWeights<Dim> w(xg);
+    const AffineTerms<Dim> terms(a, StencilOffsets<Dim>(w, xg, dx));
+    for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double) {
+      const Vec<Dim> dpos = ((w.base() + off).template cast<double>() - xg) * dx;
+      const Vec<Dim> eigen = a * dpos;
+      const Vec<Dim> ours = terms.at(off);
+      for (int i = 0; i < Dim; ++i) {
+        ASSERT_NEAR(ours[i], eigen[i], 1e-12 * (a.row(i).cwiseAbs() * dpos.cwiseAbs()).sum());
+        differ += ours[i] != eigen[i];
+      }
+    });
   }
 #ifndef __FMA__
-  EXPECT_EQ(differ, 0) << Dim << "D: components that differ from Eigen's product in the last bits";
+  EXPECT_EQ(differ, 0) << Dim << "D: components that differ from affine * Δx in the last bits";
 #endif
 }
 
-TEST(BSpline, ProductFromColumnsIsEigensProductToTheBit) {
+TEST(BSpline, AffineTermsAreTheAffineProductOfEveryNodeToTheBit) {
   std::mt19937_64 rng(13);
-  check_product_order<2>(rng);
-  check_product_order<3>(rng);
+  check_affine_terms<2>(rng);
+  check_affine_terms<3>(rng);
+}
+
+// gather_apic against the textbook sums v = Σ w v_i and B = Σ w v_i Δxᵀ (Δx = node − particle),
+// computed node by node with Eigen, on a random velocity field; and, for an affine field
+// v(x) = v0 + G x, the APIC identities v = v(x_p) and 4/dx²·B = G (quadratic B-splines
+// reproduce linear fields; Jiang et al. 2015).
+template <int Dim>
+void check_gather(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Grid<Dim> grid = test_grid<Dim>(2.0, -12, 25);  // covers every stencil of |x/dx| ≤ 8
+  Mat<Dim> g;
+  for (int i = 0; i < Dim * Dim; ++i) g.data()[i] = u(rng);
+  const Vec<Dim> v0 = Vec<Dim>::Random();
+  for (int trial = 0; trial < 500; ++trial) {
+    Vec<Dim> xg;
+    for (int a = 0; a < Dim; ++a) xg[a] = 8.0 * u(rng);
+    const StencilWeights<Dim> w(xg);
+    const StencilOffsets<Dim> d(w, xg, grid.dx);
+    // A random field: the same sums node by node.
+    for (auto& node : grid.nodes) node.vel = Vec<Dim>::Random();
+    Vec<Dim> v_ref = Vec<Dim>::Zero();
+    Mat<Dim> b_ref = Mat<Dim>::Zero();
+    for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
+      const IVec<Dim> node = w.base() + off;
+      const Vec<Dim>& vi = grid.nodes[grid.flat(node)].vel;
+      v_ref += wt * vi;
+      b_ref += wt * vi * ((node.template cast<double>() - xg) * grid.dx).transpose();
+    });
+    Vec<Dim> v;
+    Mat<Dim> b;
+    const auto vel = [&](std::size_t f) -> const Vec<Dim>& { return grid.nodes[f].vel; };
+    gather_apic<Dim>(w, d, grid.flat(w.base()), grid.strides(), vel, v, b);
+    ASSERT_LT((v - v_ref).norm(), kRoundOff) << "trial " << trial;
+    ASSERT_LT((b - b_ref).norm(), kRoundOff * grid.dx) << "trial " << trial;
+    // An affine field is gathered exactly.
+    for (std::size_t f = 0; f < grid.nodes.size(); ++f)
+      grid.nodes[f].vel = v0 + g * grid.position(grid.node_of(f));
+    gather_apic<Dim>(w, d, grid.flat(w.base()), grid.strides(), vel, v, b);
+    ASSERT_LT((v - (v0 + g * (xg * grid.dx))).norm(), kRoundOff * 100.0) << "trial " << trial;
+    ASSERT_LT((4.0 / (grid.dx * grid.dx) * b - g).norm(), kRoundOff) << "trial " << trial;
+  }
+}
+
+TEST(BSpline, GatherApicSumsTheStencilAndReproducesAffineVelocityFields) {
+  std::mt19937_64 rng(17);
+  check_gather<2>(rng);
+  check_gather<3>(rng);
 }
 
 }  // namespace
