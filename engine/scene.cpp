@@ -22,6 +22,7 @@ constexpr std::pair<Effect, const char*> kEffectNames[] = {
     {Effect::softening, "softening"},
     {Effect::outflow, "outflow"},
     {Effect::velocity_boundaries, "velocity_boundaries"},
+    {Effect::downstream_drive, "downstream_drive"},
 };
 
 std::string fmt(double v) {
@@ -140,12 +141,13 @@ double SceneConfig::p_wave_speed() const {
 }
 
 double SceneConfig::drive_velocity(double t) const {
+  if (drive_start == "moving") return drive_speed;
   if (t >= drive_ramp_time || drive_ramp_time <= 0) return drive_speed;
   return 0.5 * drive_speed * (1.0 - std::cos(std::numbers::pi * t / drive_ramp_time));
 }
 
 double SceneConfig::drive_position(double t) const {
-  const double T = drive_ramp_time;
+  const double T = drive_start == "moving" ? 0.0 : drive_ramp_time;
   if (T <= 0) return drive_speed * t;
   const double tr = std::min(t, T);
   const double ramp = 0.5 * drive_speed * (tr - T / std::numbers::pi * std::sin(std::numbers::pi * tr / T));
@@ -179,6 +181,8 @@ void SceneConfig::resolve() {
   check_range("gravity.tilt_deg", gravity_tilt_deg, -90.0, 90.0);
   check_range("drive.speed", drive_speed, 0.0, 1e3);
   check_range("drive.ramp_time", drive_ramp_time, 0.0, 1e6);
+  if (drive_start != "ramp" && drive_start != "moving")
+    fail("drive.start", "value '" + drive_start + "' is not 'ramp' or 'moving'");
   check_range("bed.friction", bed_friction, 0.0, 10.0);
   check_range("run.end_time", end_time, 0.0, 1e9);
   check_range("run.front_past_step", front_past_step, 0.0, 1e9);
@@ -222,9 +226,14 @@ void SceneConfig::resolve() {
     if (downstream_length == 0.0) downstream_length = 10.0 * ice_thickness;
     if (width == 0.0) width = ice_thickness;
     if (top_margin == 0.0) top_margin = 0.5 * ice_thickness + 4.0 * dx;
-    if (drive_ramp_time == 0.0 && has(Effect::drive)) drive_ramp_time = 100.0 * upstream_length / p_wave_speed();
+    if (drive_start == "moving") drive_ramp_time = 0.0;
+    else if (drive_ramp_time == 0.0 && has(Effect::drive)) drive_ramp_time = 100.0 * upstream_length / p_wave_speed();
     check_range("ice.upstream_length", upstream_length, 2.0 * dx, 1e7);
-    check_range("ice.draped_length", draped_length, 0.0, step_length + downstream_length - 4.0 * dx);
+    // A glacier held downstream drapes the whole bed by default, up to the outflow line.
+    if (has(Effect::downstream_drive) && draped_length == 0.0)
+      draped_length = step_length + downstream_length - 3.0 * dx;
+    // Draped ice may reach the outflow line, 3 cells before the domain's end.
+    check_range("ice.draped_length", draped_length, 0.0, step_length + downstream_length - 3.0 * dx);
     check_range("bed.downstream_length", downstream_length, 4.0 * dx, 1e7);
     check_range("ice.width", width, 2.0 * dx, 1e6);
     check_range("bed.step_height", step_height, 0.0, 1e5);
@@ -258,6 +267,17 @@ void SceneConfig::resolve() {
     if (!records_gate())
       fail("run.gate_length", "needs a slab on a 'step' or 'concave' bed with the 'plasticity' effect");
     check_range("run.gate_length", gate_length, 0.0, upstream_length, true);
+  }
+  check_range("run.gate_offset", gate_offset, 0.0, body == "slab" ? step_length + downstream_length - 8.0 * dx : 0.0);
+  if (has(Effect::downstream_drive)) {
+    if (body != "slab" || !has(Effect::drive) || !has(Effect::outflow))
+      fail("effects", "'downstream_drive' needs ice.body 'slab' and the 'drive' and 'outflow' effects");
+    // The held cells are the last 5 before the domain's end (Simulation::kDownstreamDriveCells).
+    const double reach = step_length + downstream_length - 5.0 * dx;
+    if (draped_length < reach)
+      fail("ice.draped_length", "value " + fmt(draped_length) + " leaves the downstream drive without ice: " +
+                                    "with 'downstream_drive' it must be at least bed.step_length + " +
+                                    "bed.downstream_length - 5 dx = " + fmt(reach));
   }
   if (has(Effect::basal_friction) && bed_shape == "none")
     fail("bed.shape", "'basal_friction' needs a bed");
@@ -341,6 +361,7 @@ SceneConfig scene_from_json(const nlohmann::json& j) {
     ObjectReader o(*d, "drive");
     o.number("speed", s.drive_speed);
     o.number("ramp_time", s.drive_ramp_time);
+    o.string("start", s.drive_start);
     o.refuse_unknown();
   }
   if (const auto* g = r.child("gravity")) {
@@ -397,6 +418,7 @@ SceneConfig scene_from_json(const nlohmann::json& j) {
     o.number("end_time", s.end_time);
     o.number("front_past_step", s.front_past_step);
     o.number("gate_length", s.gate_length);
+    o.number("gate_offset", s.gate_offset);
     o.integer("max_steps", s.max_steps);
     o.number("wall_time_limit", s.wall_time_limit);
     o.refuse_unknown();
@@ -452,7 +474,7 @@ nlohmann::json scene_to_json(const SceneConfig& s) {
         {"downstream_length", s.downstream_length},
         {"friction", s.bed_friction},
         {"z", s.flat_bed_z}}},
-      {"drive", {{"speed", s.drive_speed}, {"ramp_time", s.drive_ramp_time}}},
+      {"drive", {{"speed", s.drive_speed}, {"ramp_time", s.drive_ramp_time}, {"start", s.drive_start}}},
       {"gravity", {{"g", s.gravity}, {"tilt_deg", s.gravity_tilt_deg}}},
       {"numerics",
        {{"dx", s.dx},
@@ -466,6 +488,7 @@ nlohmann::json scene_to_json(const SceneConfig& s) {
        {{"end_time", s.end_time},
         {"front_past_step", s.front_past_step},
         {"gate_length", s.gate_length},
+        {"gate_offset", s.gate_offset},
         {"max_steps", s.max_steps},
         {"wall_time_limit", s.wall_time_limit}}},
       {"output", {{"vtu_interval", s.vtu_interval}, {"png", s.png}}},

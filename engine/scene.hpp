@@ -22,6 +22,7 @@ enum class Effect {
   softening,            // cap softens with ε_v^p (needs plasticity)
   outflow,              // remove ice that leaves the downstream end
   velocity_boundaries,  // boxes of grid nodes moving at a prescribed velocity
+  downstream_drive,     // the ice at the downstream end moves at the drive speed (outflow held)
 };
 const char* effect_name(Effect e);
 Effect effect_from_name(const std::string& name);  // throws InputError
@@ -83,6 +84,10 @@ struct SceneConfig {
   // longer than the slab's first period 4 L_up/c_p makes the start quasi-static: the inertial
   // compression ρ L_up V_x π/(2T) is then ~70 kPa and the ringing negligible. 0 → 100 L_up/c_p.
   double drive_ramp_time = 0.0;       // T [s]
+  // How the glacier starts. "ramp": at rest, the drive accelerating over drive_ramp_time.
+  // "moving": once settled, the glacier slides as a rigid body at V_x and the drives run at V_x
+  // from t = 0: no ramp at all, so nothing in the start grows with the slab's length.
+  std::string drive_start = "ramp";
   double gravity = 9.81;              // g [m/s²]
   double gravity_tilt_deg = 0.0;      // tilt of gravity towards +x (incline tests) [deg]
 
@@ -107,6 +112,10 @@ struct SceneConfig {
   // Stop once this much ice, as a length along flow, has passed the measurement gate at the top
   // of the step [m]; 0 = off. Only for a slab on a step or concave bed with plasticity.
   double gate_length = 0.0;
+  // Where the gate stands past the top of the step, horizontally [m]: 0 records the ice as it
+  // reaches the lip (the cliff start, whose blocks break off there); a flowing glacier cracks
+  // as it bends over the lip, so its crevasses are recorded a little way down the ramp.
+  double gate_offset = 0.0;
   std::int64_t max_steps = 0;         // 0 = unlimited
   double wall_time_limit = 0.0;       // [s]; 0 = unlimited
 
@@ -123,7 +132,7 @@ struct SceneConfig {
   // The measurement gate records damage as the ice reaches the top of the step: for a slab on
   // a step or concave bed, with plasticity (docs/measurement.md, "Gate frame").
   bool records_gate() const;
-  double gate_x() const { return step_top_x(); }
+  double gate_x() const { return step_top_x() + gate_offset; }
   double step_foot_x() const { return upstream_length + step_length; }
   double p_wave_speed() const;
   double drive_velocity(double t) const;  // piston speed at time t [m/s]

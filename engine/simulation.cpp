@@ -94,6 +94,8 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   if (scene_.has(Effect::drive)) add_stage("drive_grid", [this] { drive_grid_nodes(); });
   if (scene_.has(Effect::basal_friction))
     add_stage("basal_friction", [this] { apply_bed_friction_to_grid(); });
+  if (scene_.has(Effect::downstream_drive))
+    add_stage("downstream_drive", [this] { drive_downstream_nodes(); });
   if (scene_.has(Effect::lateral_walls)) {
     add_stage("lateral_walls", [this] {
       apply_walls_to_grid({1}, domain_lo_, domain_hi_);
@@ -354,12 +356,23 @@ void Simulation<Dim>::settle() {
     particles_.v[p].setZero();
     particles_.C[p].setZero();
   }
+  if (scene_.drive_start == "moving") start_moving();
   time_ = 0.0;
   steps_ = 0;
   particle_steps_ = 0;
   return_map_evaluations_ = 0;
   for (auto& st : stages_) st = {st.name, 0, 0.0};
   update_time_step();
+}
+
+template <int Dim>
+void Simulation<Dim>::start_moving() {
+  // The settled glacier is set sliding as a rigid body at V_x, the speed the drives hold from
+  // t = 0: a rigid translation carries no stress, so the start sends no wave through the ice,
+  // however long it is. Ice over the ramp then settles onto its bed under gravity; a start with
+  // each column already following the bed (v_z = V_x z_b'(x)) has a jump of v_z at the lip and
+  // the foot, and cracked both at once (twice the damaged particles after 1 s at H_i = 200 m).
+  for (std::size_t p = 0; p < particles_.size(); ++p) particles_.v[p][0] = scene_.drive_speed;
 }
 
 template <int Dim>
@@ -559,6 +572,24 @@ void Simulation<Dim>::drive_grid_nodes() {
     const double share = std::min(1.0, drive_node_mass_[f] / grid_.nodes[f].mass);
     grid_.nodes[f].vel[0] += share * (v - grid_.nodes[f].vel[0]);
   }
+}
+
+template <int Dim>
+void Simulation<Dim>::drive_downstream_nodes() {
+  // The glacier goes on past the domain: the nodes of the last cells before the outflow line
+  // move with it, at (V(t), 0) on the flat floor. Without this the floor ice is free to be
+  // pushed away by the ice on the ramp, which at μ_b = 0.1 is not held by friction alone
+  // (ρ g H_i (H_s − μ_b L_s) down the ramp against μ_b ρ g H_i L_floor on the floor).
+  const double v = settling_ ? 0.0 : scene_.drive_velocity(time_);
+  const double x_hold = domain_hi_[0] - kDownstreamDriveCells * scene_.dx;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid_.node_count(), kGrain), [&](const auto& r) {
+    for (std::size_t f = r.begin(); f != r.end(); ++f) {
+      if (grid_.nodes[f].mass <= 0.0) continue;
+      if (grid_.position(grid_.node_of(f))[0] < x_hold) continue;
+      grid_.nodes[f].vel.setZero();
+      grid_.nodes[f].vel[0] = v;
+    }
+  });
 }
 
 template <int Dim>
@@ -1016,16 +1047,21 @@ void Simulation<Dim>::remove_outflow() {
 
 template <int Dim>
 void Simulation<Dim>::init_gate() {
+  // Ice that starts past the gate (a draped glacier) never passes it: it is marked so, and
+  // only ice that crosses the gate is recorded and counted in the passed length.
   auto& P = particles_;
   const double gx = scene_.gate_x();
   P.x_ref.resize(P.size());
-  P.gate_eps.assign(P.size(), -1.0f);
+  P.gate_eps.assign(P.size(), kGateNotYet);
   double upstream_volume = 0.0;
   for (std::size_t p = 0; p < P.size(); ++p) {
     for (int a = 0; a < Dim; ++a) P.x_ref[p][a] = static_cast<float>(P.x[p][a]);
     if (P.x[p][0] < gx) upstream_volume += P.vol0[p];
+    else P.gate_eps[p] = kGateNever;
   }
-  gate_cross_section_ = upstream_volume > 0.0 ? upstream_volume / scene_.upstream_length : 1.0;
+  // Every column of ice upstream of the gate is H_i high (on the plateau and, draped, on the
+  // ramp), and the ice starts at x = 0.
+  gate_cross_section_ = upstream_volume > 0.0 ? upstream_volume / gx : 1.0;
 }
 
 template <int Dim>
@@ -1034,7 +1070,7 @@ void Simulation<Dim>::record_gate() {
   auto& P = particles_;
   const double gx = scene_.gate_x();
   for (std::size_t p = 0; p < P.size(); ++p) {
-    if (P.gate_eps[p] >= 0.0f || P.x[p][0] < gx) continue;
+    if (P.gate_eps[p] != kGateNotYet || P.x[p][0] < gx) continue;
     P.gate_eps[p] = static_cast<float>(P.eps_v_p[p]);
     gate_passed_volume_ += P.vol0[p];
   }

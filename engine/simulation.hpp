@@ -125,6 +125,11 @@ class Simulation {
   void for_each_particle_coloured(Fn&& fn);  // race-free P2G-style traversal by x-slab parity
   void grid_velocity(const Vec<Dim>& gravity);
   void drive_grid_nodes();
+  void drive_downstream_nodes();
+  void start_moving();  // drive.start "moving": the settled glacier set in motion along its bed
+  // downstream_drive holds the nodes of this many cells upstream of the domain's end (the
+  // outflow line is 3 cells from it, so 2 cells of ice before it move at the drive speed).
+  static constexpr double kDownstreamDriveCells = 5.0;
   void apply_bed_friction_to_grid();
   void apply_walls_to_grid(const std::vector<int>& axes, const Vec<Dim>& lo, const Vec<Dim>& hi);
   void apply_velocity_boxes_to_grid();
@@ -163,6 +168,9 @@ class Simulation {
   void finish_step();
   void remove_outflow();
   void init_gate();
+  // gate_eps of a particle not recorded yet, and of one that started past the gate; recorded
+  // values are ε_v^p ≥ 0.
+  static constexpr float kGateNotYet = -1.0f, kGateNever = -2.0f;
   void record_gate();
   void update_time_step();
 

@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 
+#include "analysis/bed_contact.hpp"
 #include "analysis/crevasse_measure.hpp"
 #include "analysis/measurement_io.hpp"
 #include "analysis/side_view.hpp"
@@ -54,7 +55,8 @@ class CliObserver : public RunObserver {
     std::ofstream f(out_ / "measurements_over_time.csv", first ? std::ios::trunc : std::ios::app);
     if (first)
       f << "time_s,gate_passed_length_m,frame,window_min_x_m,window_max_x_m,crevasse_count,"
-           "spacing_q25_m,spacing_median_m,spacing_q75_m,depth_median_m,fragmented,no_crevasse\n";
+           "spacing_q25_m,spacing_median_m,spacing_q75_m,depth_median_m,fragmented,no_crevasse,"
+           "ramp_gap_max_m,ramp_gap_x_m\n";
     auto num = [](const std::optional<analysis::QuartileSummary>& q, int k) {
       if (!q) return std::string();
       return std::to_string(k == 0 ? q->q25 : k == 1 ? q->median : q->q75);
@@ -63,7 +65,14 @@ class CliObserver : public RunObserver {
       << m.settings.window_min_x_m << "," << m.settings.window_max_x_m << ","
       << m.crevasses.size() << "," << num(m.spacing_m, 0) << "," << num(m.spacing_m, 1) << ","
       << num(m.spacing_m, 2) << "," << num(m.depth_m, 1) << "," << m.flags.fragmented << ","
-      << m.flags.no_crevasse << "\n";
+      << m.flags.no_crevasse << ",";
+    if (s.bed_profile.size() >= 2 && s.step_foot_x_m > s.step_top_x_m) {
+      const auto c = analysis::ramp_contact(s);
+      f << c.max_gap_m << "," << c.max_gap_x_m;
+    } else {
+      f << ",";
+    }
+    f << "\n";
     ++rows_;
   }
 

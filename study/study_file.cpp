@@ -51,6 +51,8 @@ std::optional<Range> named_range(const std::string& name) {
   static const std::map<std::string, Range> ranges = {
       {"thickness", {0.0, 1e5, true, false}},
       {"cohesion_ratio", {0.0, 1e4, true, false}},
+      {"shear_strength_ratio", {0.0, 1e4, true, false}},
+      {"gate_offset_ratio", {0.0, 1e3, false, false}},
       {"step_length_ratio", {0.0, 1e3, false, false}},
       {"slope", {0.0, 1e3, true, false}},
       {"step_height_ratio", {0.0, 1e3, false, false}},
@@ -71,6 +73,8 @@ const std::map<std::string, std::string>& named_targets() {
   static const std::map<std::string, std::string> t = {
       {"thickness", "/ice/thickness"},
       {"cohesion_ratio", "/ice/tensile_strength"},
+      {"shear_strength_ratio", "/ice/shear_strength"},
+      {"gate_offset_ratio", "/run/gate_offset"},
       {"step_length_ratio", "/bed/step_length"},
       {"slope", "/bed/step_height"},
       {"step_height_ratio", "/bed/step_height"},
@@ -490,12 +494,15 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
     if (has("thickness")) h_i = named["thickness"];
     scene["ice"]["thickness"] = h_i;
     if (has("cells_per_thickness")) scene["numerics"]["dx"] = h_i / named["cells_per_thickness"];
-    if (has("cohesion_ratio")) {
+    // Strengths given relative to the overburden ρ_i g H_i.
+    for (const auto& [name, field] : {std::pair{"cohesion_ratio", "tensile_strength"},
+                                      std::pair{"shear_strength_ratio", "shear_strength"}}) {
+      if (!has(name)) continue;
       const double rho = number_at(scene, "/ice/density", defaults.density);
       const double g = number_at(scene, "/gravity/g", defaults.gravity);
       if (!(g > 0))
-        fail(where, "cohesion_ratio needs gravity.g > 0 (Π = c / (ρ_i g H_i)), got g = " + fmt(g));
-      scene["ice"]["tensile_strength"] = named["cohesion_ratio"] * rho * g * h_i;
+        fail(where, std::string(name) + " needs gravity.g > 0 (it is relative to ρ_i g H_i), got g = " + fmt(g));
+      scene["ice"][field] = named[name] * rho * g * h_i;
     }
     if (has("step_length_ratio")) scene["bed"]["step_length"] = named["step_length_ratio"] * h_i;
     if (has("slope")) {
@@ -517,6 +524,7 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
     if (has("front_past_step_ratio"))
       scene["run"]["front_past_step"] = named["front_past_step_ratio"] * h_i;
     if (has("gate_length_ratio")) scene["run"]["gate_length"] = named["gate_length_ratio"] * h_i;
+    if (has("gate_offset_ratio")) scene["run"]["gate_offset"] = named["gate_offset_ratio"] * h_i;
     if (has("upstream_length_ratio"))
       scene["ice"]["upstream_length"] = named["upstream_length_ratio"] * h_i;
     if (has("downstream_length_ratio"))

@@ -22,6 +22,8 @@ namespace crevasse {
 inline constexpr const char* kStudyParameterNames[] = {
     "thickness",               // H_i [m]
     "cohesion_ratio",          // Π = c / (ρ_i g H_i)
+    "shear_strength_ratio",    // q_y / (ρ_i g H_i)
+    "gate_offset_ratio",       // gate past the top of the step / H_i
     "step_length_ratio",       // r = L_s / H_i (0 = vertical step)
     "slope",                   // S = H_s / L_s
     "step_height_ratio",       // h = H_s / H_i (instead of slope; the only choice when r = 0)
