@@ -288,25 +288,73 @@ CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
 
   const DamageClusters clusters = find_damage_clusters(px, pz, damaged, r.link_distance_m);
   m.cluster_count = clusters.count;
-  std::vector<ClusterTally> tally(clusters.count);
+  // Each place where a damaged cluster meets the surface is a crevasse of its own: one cluster
+  // may reach the surface at several openings separated by intact surface, when crevasses branch
+  // from one root or are joined at depth (by a damaged layer along the bed, say). A cluster's
+  // particles belong to the nearest opening along x (within half a particle spacing of the
+  // midpoint between two, to both), and an opening's depth is the lowest of its particles.
+  std::vector<std::vector<double>> surface_x(clusters.count);
+  auto reaches_surface = [&](std::size_t p) {
+    return pz[p] + half_spacing >= m.surface.height_at(px[p]) - r.surface_reach_m;
+  };
+  auto bin_of = [&](double x) {
+    return std::min(m.surface.size() - 1,
+                    static_cast<std::size_t>(std::max(0.0, std::floor((x - m.surface.x0_m) / r.dx_m))));
+  };
+  // Surface bins where intact ice reaches the surface: two openings of one cluster are apart
+  // only where such a bin lies between them (a wide-open crevasse has none between its walls).
+  std::vector<std::uint8_t> intact_top(m.surface.size(), 0);
   for (std::size_t p = 0; p < px.size(); ++p) {
+    if (!reaches_surface(p)) continue;
     const auto c = clusters.label[p];
-    if (c == DamageClusters::kNone) continue;
-    ClusterTally& t = tally[static_cast<std::size_t>(c)];
+    if (c != DamageClusters::kNone) surface_x[static_cast<std::size_t>(c)].push_back(px[p]);
+    else if (!damaged[p]) intact_top[bin_of(px[p])] = 1;
+  }
+  auto intact_between = [&](double a, double b) {
+    for (std::size_t k = bin_of(a) + 1; k < bin_of(b); ++k)
+      if (intact_top[k]) return true;
+    return false;
+  };
+  // Openings per cluster, as [first, last) into `tally`, and the x boundaries between them.
+  std::vector<ClusterTally> tally;
+  std::vector<std::size_t> first(clusters.count + 1, 0);
+  std::vector<std::vector<double>> bounds(clusters.count);
+  for (std::size_t c = 0; c < clusters.count; ++c) {
+    first[c] = tally.size();
+    auto& xs = surface_x[c];
+    std::sort(xs.begin(), xs.end());
+    for (std::size_t i = 0; i < xs.size(); ++i) {
+      if (i == 0 || (xs[i] - xs[i - 1] > r.link_distance_m && intact_between(xs[i - 1], xs[i]))) {
+        if (i > 0) bounds[c].push_back(0.5 * (xs[i] + xs[i - 1]));
+        tally.emplace_back();
+      }
+      ClusterTally& t = tally.back();
+      ++t.surface_count;
+      t.surface_x_sum += xs[i];
+      t.surface_x_min = std::min(t.surface_x_min, xs[i]);
+      t.surface_x_max = std::max(t.surface_x_max, xs[i]);
+    }
+  }
+  first[clusters.count] = tally.size();
+  for (std::size_t p = 0; p < px.size(); ++p) {
+    const auto label = clusters.label[p];
+    if (label == DamageClusters::kNone) continue;
+    const auto c = static_cast<std::size_t>(label);
+    if (first[c] == first[c + 1]) continue;  // buried damage is not a crevasse
+    const auto& b = bounds[c];
+    const std::size_t k = static_cast<std::size_t>(std::upper_bound(b.begin(), b.end(), px[p]) - b.begin());
+    ClusterTally& t = tally[first[c] + k];
     ++t.particle_count;
     t.z_min = std::min(t.z_min, pz[p]);
-    // The top of the particle's volume within reach of the material surface.
-    if (pz[p] + half_spacing >= m.surface.height_at(px[p]) - r.surface_reach_m) {
-      ++t.surface_count;
-      t.surface_x_sum += px[p];
-      t.surface_x_min = std::min(t.surface_x_min, px[p]);
-      t.surface_x_max = std::max(t.surface_x_max, px[p]);
-    }
+    // On the midpoint between two openings (the stem of a symmetric branch) it is both's.
+    if (k > 0 && px[p] - b[k - 1] <= half_spacing)
+      tally[first[c] + k - 1].z_min = std::min(tally[first[c] + k - 1].z_min, pz[p]);
+    if (k < b.size() && b[k] - px[p] <= half_spacing)
+      tally[first[c] + k + 1].z_min = std::min(tally[first[c] + k + 1].z_min, pz[p]);
   }
 
   std::vector<Candidate> candidates;
   for (const ClusterTally& t : tally) {
-    if (t.surface_count == 0) continue;  // buried damage is not a crevasse
     Candidate c;
     c.crevasse.x_m = t.surface_x_sum / static_cast<double>(t.surface_count);
     if (!window_has_length || !in_window(c.crevasse.x_m)) continue;

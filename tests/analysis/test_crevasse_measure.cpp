@@ -155,6 +155,54 @@ TEST(MeasureFloor, NotchesCloserThanTheFloorCountAsOne) {
   for (double s : m.spacings_m) EXPECT_GE(s, m.settings.resolution_floor_m);
 }
 
+// Damage every particle of `s` inside the box [x0, x1] × [z0, z1] (to the notches' ε_v^p).
+void damage_box(ParticleSnapshot& s, const SlabSpec& spec, double x0, double x1, double z0, double z1) {
+  for (std::size_t p = 0; p < s.size(); ++p)
+    if (s.x[p] >= x0 && s.x[p] <= x1 && s.z[p] >= z0 && s.z[p] <= z1) s.eps_v_p[p] = spec.notch_eps_v_p;
+}
+
+// Two crevasses joined at depth by a damaged layer along the bed are one damaged cluster, but
+// two crevasses: each where it meets the surface, each reaching the bed through the layer
+// (full depth). A third, apart, keeps its partial depth.
+TEST(MeasureJoined, CrevassesJoinedAlongTheBedAreCountedAtEachOpeningAndReachTheBed) {
+  SlabSpec spec;
+  const double h = test::spacing_of(spec);
+  ParticleSnapshot s = make_slab(spec, {{.x_m = 402.5, .depth_m = 40.0},
+                                        {.x_m = 602.5, .depth_m = 60.0},
+                                        {.x_m = 902.5, .depth_m = 30.0}});
+  damage_box(s, spec, 400.0, 605.0, 0.0, 10.0);               // the layer along the bed
+  damage_box(s, spec, 400.0, 405.0, 0.0, spec.thickness_m);  // the first notch reaches it,
+  damage_box(s, spec, 600.0, 605.0, 0.0, spec.thickness_m);  // and so does the second
+  const CrevasseMeasurement m = measure_crevasses(s);
+  EXPECT_EQ(m.cluster_count, 2u);
+  ASSERT_EQ(m.crevasses.size(), 3u);
+  EXPECT_NEAR(m.crevasses[0].x_m, 402.5, h);
+  EXPECT_NEAR(m.crevasses[0].depth_m, spec.thickness_m, h);
+  EXPECT_NEAR(m.crevasses[1].x_m, 602.5, h);
+  EXPECT_NEAR(m.crevasses[1].depth_m, spec.thickness_m, h);
+  EXPECT_NEAR(m.crevasses[2].x_m, 902.5, h);
+  EXPECT_NEAR(m.crevasses[2].depth_m, 30.0, h);
+  ASSERT_EQ(m.spacings_m.size(), 2u);
+  EXPECT_NEAR(m.spacings_m[0], 200.0, h);
+}
+
+// A crevasse that branches: one stem from 40 to 80 m deep, two arms to the surface 60 m apart.
+// Two openings, two crevasses, each as deep as the stem.
+TEST(MeasureBranched, BranchedCrevasseHasACrevasseAtEachArm) {
+  SlabSpec spec;
+  const double h = test::spacing_of(spec);
+  const double top = spec.thickness_m;
+  ParticleSnapshot s = make_slab(spec, {{.x_m = 502.5, .depth_m = 45.0}, {.x_m = 562.5, .depth_m = 45.0}});
+  damage_box(s, spec, 500.0, 565.0, top - 45.0, top - 40.0);  // the arms' common root
+  damage_box(s, spec, 530.0, 535.0, top - 80.0, top - 40.0);  // the stem
+  const CrevasseMeasurement m = measure_crevasses(s);
+  EXPECT_EQ(m.cluster_count, 1u);
+  ASSERT_EQ(m.crevasses.size(), 2u);
+  EXPECT_NEAR(m.crevasses[0].x_m, 502.5, h);
+  EXPECT_NEAR(m.crevasses[1].x_m, 562.5, h);
+  for (const Crevasse& c : m.crevasses) EXPECT_NEAR(c.depth_m, 80.0, h);
+}
+
 TEST(MeasureSlope, DepthIsRelativeToTheLocalSurfaceOnASlope) {
   // The surface drops 200 m over the slab (slope 0.1): a global surface height would be wrong
   // by up to 200 m.

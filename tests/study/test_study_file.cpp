@@ -410,3 +410,21 @@ TEST(ShippedStudies, AllLoadAndQuickSpansWeakToStrongIce) {
 
 }  // namespace
 }  // namespace crevasse
+
+namespace crevasse {
+namespace {
+
+// Strengths relative to the overburden, and the gate's place past the lip in H_i.
+TEST(StudyFile, ShearStrengthRatioAndGateOffsetRatioScaleWithThickness) {
+  nlohmann::json j = {{"name", "t"}, {"base_scene", test::tiny_scene()}};
+  j["fixed"] = {{"thickness", 40.0}, {"shear_strength_ratio", 1.5}, {"gate_offset_ratio", 0.25}};
+  const Study s = test::parse(j);
+  ASSERT_EQ(s.cases.size(), 1u);
+  const SceneConfig& c = s.cases[0].scene;
+  EXPECT_DOUBLE_EQ(c.shear_strength, 1.5 * c.density * c.gravity * 40.0);
+  EXPECT_DOUBLE_EQ(c.gate_offset, 10.0);
+  EXPECT_DOUBLE_EQ(c.gate_x(), c.step_top_x() + 10.0);
+}
+
+}  // namespace
+}  // namespace crevasse
