@@ -297,13 +297,17 @@ CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
   auto reaches_surface = [&](std::size_t p) {
     return pz[p] + half_spacing >= m.surface.height_at(px[p]) - r.surface_reach_m;
   };
+  // Bins one particle spacing wide where intact ice reaches the surface: two openings of one
+  // cluster are apart only where such a bin lies between them (a wide-open crevasse has none
+  // between its walls; a strip of intact ice one particle wide is one).
+  const double top_bin = r.particle_spacing_m;
+  const auto top_bins = static_cast<std::size_t>(
+      std::ceil(static_cast<double>(m.surface.size()) * r.dx_m / top_bin)) + 1;
   auto bin_of = [&](double x) {
-    return std::min(m.surface.size() - 1,
-                    static_cast<std::size_t>(std::max(0.0, std::floor((x - m.surface.x0_m) / r.dx_m))));
+    return std::min(top_bins - 1,
+                    static_cast<std::size_t>(std::max(0.0, std::floor((x - m.surface.x0_m) / top_bin))));
   };
-  // Surface bins where intact ice reaches the surface: two openings of one cluster are apart
-  // only where such a bin lies between them (a wide-open crevasse has none between its walls).
-  std::vector<std::uint8_t> intact_top(m.surface.size(), 0);
+  std::vector<std::uint8_t> intact_top(top_bins, 0);
   for (std::size_t p = 0; p < px.size(); ++p) {
     if (!reaches_surface(p)) continue;
     const auto c = clusters.label[p];
@@ -367,7 +371,9 @@ CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
     c.crevasse.surface_z_m =
         (1.0 - t_lip) * m.surface.height_at(x_left_lip) + t_lip * m.surface.height_at(x_right_lip);
     c.crevasse.bottom_z_m = t.z_min - half_spacing;
-    c.crevasse.depth_m = std::max(0.0, c.crevasse.surface_z_m - c.crevasse.bottom_z_m);
+    // At most the ice's thickness (full depth): in the gate frame a layer damaged along the bed
+    // may link to ice that started on the ramp, below the plateau's bed.
+    c.crevasse.depth_m = std::clamp(c.crevasse.surface_z_m - c.crevasse.bottom_z_m, 0.0, r.ice_thickness_m);
     c.crevasse.particle_count = t.particle_count;
     c.crevasse.width_m = c.right_m - c.left_m;
     candidates.push_back(c);
