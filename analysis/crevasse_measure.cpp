@@ -297,9 +297,11 @@ CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
   auto reaches_surface = [&](std::size_t p) {
     return pz[p] + half_spacing >= m.surface.height_at(px[p]) - r.surface_reach_m;
   };
-  // Bins one particle spacing wide where intact ice reaches the surface: two openings of one
-  // cluster are apart only where such a bin lies between them (a wide-open crevasse has none
-  // between its walls; a strip of intact ice one particle wide is one).
+  // The surface in bins one particle spacing wide, each with its topmost particle. An opening
+  // is a run of bins whose topmost particle is damaged; two openings of one cluster are apart
+  // only where a bin between them has intact ice on top (a wide-open crevasse has none between
+  // its walls; a strip of intact ice one particle wide is one). Inclined crevasses side by side
+  // overlap in x within the surface reach below such a strip, so the reach alone cannot part them.
   const double top_bin = r.particle_spacing_m;
   const auto top_bins = static_cast<std::size_t>(
       std::ceil(static_cast<double>(m.surface.size()) * r.dx_m / top_bin)) + 1;
@@ -307,36 +309,52 @@ CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
     return std::min(top_bins - 1,
                     static_cast<std::size_t>(std::max(0.0, std::floor((x - m.surface.x0_m) / top_bin))));
   };
-  std::vector<std::uint8_t> intact_top(top_bins, 0);
+  constexpr std::size_t kNoParticle = static_cast<std::size_t>(-1);
+  std::vector<std::size_t> topmost(top_bins, kNoParticle);
   for (std::size_t p = 0; p < px.size(); ++p) {
-    if (!reaches_surface(p)) continue;
+    std::size_t& t = topmost[bin_of(px[p])];
+    if (t == kNoParticle || pz[p] > pz[t]) t = p;
+  }
+  std::vector<std::uint8_t> intact_top(top_bins, 0);
+  std::vector<std::vector<double>> top_x(clusters.count);
+  for (std::size_t t : topmost) {
+    if (t == kNoParticle || !reaches_surface(t)) continue;
+    if (!damaged[t]) intact_top[bin_of(px[t])] = 1;
+    else top_x[static_cast<std::size_t>(clusters.label[t])].push_back(px[t]);
+  }
+  for (std::size_t p = 0; p < px.size(); ++p) {
     const auto c = clusters.label[p];
-    if (c != DamageClusters::kNone) surface_x[static_cast<std::size_t>(c)].push_back(px[p]);
-    else if (!damaged[p]) intact_top[bin_of(px[p])] = 1;
+    if (c != DamageClusters::kNone && reaches_surface(p)) surface_x[static_cast<std::size_t>(c)].push_back(px[p]);
   }
   auto intact_between = [&](double a, double b) {
     for (std::size_t k = bin_of(a) + 1; k < bin_of(b); ++k)
       if (intact_top[k]) return true;
     return false;
   };
-  // Openings per cluster, as [first, last) into `tally`, and the x boundaries between them.
+  // Openings per cluster, as [first, last) into `tally`, and the x boundaries between them; a
+  // cluster that reaches the surface only under intact ice has one opening.
   std::vector<ClusterTally> tally;
   std::vector<std::size_t> first(clusters.count + 1, 0);
   std::vector<std::vector<double>> bounds(clusters.count);
   for (std::size_t c = 0; c < clusters.count; ++c) {
     first[c] = tally.size();
     auto& xs = surface_x[c];
+    if (xs.empty()) continue;
     std::sort(xs.begin(), xs.end());
-    for (std::size_t i = 0; i < xs.size(); ++i) {
-      if (i == 0 || (xs[i] - xs[i - 1] > r.link_distance_m && intact_between(xs[i - 1], xs[i]))) {
-        if (i > 0) bounds[c].push_back(0.5 * (xs[i] + xs[i - 1]));
-        tally.emplace_back();
-      }
-      ClusterTally& t = tally.back();
+    auto& tops = top_x[c];
+    std::sort(tops.begin(), tops.end());
+    for (std::size_t i = 1; i < tops.size(); ++i)
+      if (tops[i] - tops[i - 1] > r.link_distance_m && intact_between(tops[i - 1], tops[i]))
+        bounds[c].push_back(0.5 * (tops[i] + tops[i - 1]));
+    tally.resize(tally.size() + bounds[c].size() + 1);
+    for (double x : xs) {
+      const auto k = static_cast<std::size_t>(std::upper_bound(bounds[c].begin(), bounds[c].end(), x) -
+                                              bounds[c].begin());
+      ClusterTally& t = tally[first[c] + k];
       ++t.surface_count;
-      t.surface_x_sum += xs[i];
-      t.surface_x_min = std::min(t.surface_x_min, xs[i]);
-      t.surface_x_max = std::max(t.surface_x_max, xs[i]);
+      t.surface_x_sum += x;
+      t.surface_x_min = std::min(t.surface_x_min, x);
+      t.surface_x_max = std::max(t.surface_x_max, x);
     }
   }
   first[clusters.count] = tally.size();
@@ -359,6 +377,7 @@ CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
 
   std::vector<Candidate> candidates;
   for (const ClusterTally& t : tally) {
+    if (t.surface_count == 0) continue;
     Candidate c;
     c.crevasse.x_m = t.surface_x_sum / static_cast<double>(t.surface_count);
     if (!window_has_length || !in_window(c.crevasse.x_m)) continue;
