@@ -6,28 +6,16 @@
 #include <stdexcept>
 #include <vector>
 
+#include "engine/bed.hpp"
+
 namespace crevasse::analysis {
-namespace {
-
-// The bed profile is a polyline in x; on a vertical segment the upper value.
-double bed_height(const std::vector<std::array<double, 2>>& v, double x) {
-  if (x <= v.front()[0]) return v.front()[1];
-  for (std::size_t i = 1; i < v.size(); ++i) {
-    if (x > v[i][0]) continue;
-    const double w = v[i][0] - v[i - 1][0];
-    if (w <= 0.0) return std::max(v[i][1], v[i - 1][1]);
-    return v[i - 1][1] + (x - v[i - 1][0]) / w * (v[i][1] - v[i - 1][1]);
-  }
-  return v.back()[1];
-}
-
-}  // namespace
 
 BedContact bed_contact(const ParticleSnapshot& s, double x_min, double x_max) {
   if (s.bed_profile.size() < 2) throw std::invalid_argument("bed contact: the snapshot has no bed profile");
   if (!(s.dx_m > 0.0)) throw std::invalid_argument("bed contact: the snapshot has no dx");
   BedContact c;
   if (!(x_max > x_min)) return c;
+  const Bed bed = Bed::polyline(s.bed_profile);
   const double dx = s.dx_m;
   c.columns = static_cast<std::size_t>(std::ceil((x_max - x_min) / dx));
   const double half_spacing = 0.5 * (s.particle_spacing_m > 0.0 ? s.particle_spacing_m : 0.5 * dx);
@@ -35,7 +23,7 @@ BedContact bed_contact(const ParticleSnapshot& s, double x_min, double x_max) {
   for (std::size_t p = 0; p < s.x.size(); ++p) {
     if (s.x[p] < x_min || s.x[p] >= x_max) continue;
     const auto i = std::min(c.columns - 1, static_cast<std::size_t>((s.x[p] - x_min) / dx));
-    lowest[i] = std::min(lowest[i], s.z[p] - bed_height(s.bed_profile, s.x[p]));
+    lowest[i] = std::min(lowest[i], s.z[p] - bed.height_at(s.x[p]));
   }
   bool any = false;
   for (std::size_t i = 0; i < c.columns; ++i) {

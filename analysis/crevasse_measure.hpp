@@ -1,6 +1,6 @@
 #pragma once
-// Crevasse positions, depths and spacings from a particle snapshot (SPEC §5,
-// research_physics.md §4). Definitions and the reasons for each default: docs/measurement.md.
+// Crevasse positions, depths and spacings from a particle snapshot (docs/measurement.md,
+// docs/measurement.md). Definitions and the reasons for each default: docs/measurement.md.
 #include <cstddef>
 #include <optional>
 #include <string>
@@ -14,7 +14,7 @@ namespace crevasse::analysis {
 // Every length default is a multiple of dx, H_i or the particle spacing, so that a setting means
 // the same thing at every resolution and thickness. Optional fields override the snapshot.
 struct MeasureSettings {
-  // Damaged ⇔ 1 − exp(−ζ ε_v^p) ≥ damage_threshold (SPEC §5); tied to strength loss, so it
+  // Damaged ⇔ 1 − exp(−ζ ε_v^p) ≥ damage_threshold (docs/measurement.md); tied to strength loss, so it
   // stays consistent when ζ is scaled with dx.
   double damage_threshold = 0.95;
   // Used instead when the snapshot has no softening (ζ = 0): damaged ⇔ ε_v^p ≥ this.
@@ -24,7 +24,7 @@ struct MeasureSettings {
   //   "gate":  the damage each particle carried when it reached the top of the step, drawn at
   //            its initial position — the fracture pattern the ice took over the step, before
   //            falling blocks shatter on the floor. Needs a snapshot with gate records.
-  //   "final": the particles where they are at the snapshot's time (SPEC §5 as written).
+  //   "final": the particles where they are at the snapshot's time (docs/measurement.md as written).
   //   "auto":  "gate" when the snapshot has gate records, else "final".
   std::string frame = "auto";
 
@@ -38,7 +38,7 @@ struct MeasureSettings {
   double window_margin_over_h = 0.5;
 
   // Neighbouring crevasses closer than this are one feature at this resolution: merged, and
-  // the spacing between them is dropped and counted (SPEC §5).
+  // the spacing between them is dropped and counted (docs/measurement.md).
   double resolution_floor_over_dx = 3.0;
   // Damaged particles closer than this belong to one crevasse; 1.5 spacings links axial and
   // diagonal lattice neighbours but not particles across a one-particle intact gap.

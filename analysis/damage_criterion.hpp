@@ -1,5 +1,5 @@
 #pragma once
-// When a particle counts as damaged (SPEC §5), and a continuous damage level for figures that
+// When a particle counts as damaged (docs/measurement.md), and a continuous damage level for figures that
 // agrees with that decision at the threshold.
 #include "engine/snapshot.hpp"
 

@@ -1,6 +1,6 @@
 #pragma once
 // Files written for one measured snapshot: crevasses.csv (one row per crevasse) and a JSON
-// summary with the statistics, flags, full lists and the settings used (SPEC §5: every
+// summary with the statistics, flags, full lists and the settings used (docs/measurement.md: every
 // result carries its threshold, window and timing).
 #include <filesystem>
 #include <nlohmann/json.hpp>

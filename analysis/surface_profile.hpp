@@ -1,5 +1,5 @@
 #pragma once
-// The upper ice surface z_s(x) as seen from the particles (research_physics.md §4, step 2):
+// The upper ice surface z_s(x) as seen from the particles (docs/measurement.md):
 // per x-bin the highest undamaged particle, with dips bridged so that an open or damaged
 // crevasse does not pull the surface down into itself, then smoothed.
 #include <cstdint>

@@ -1,4 +1,4 @@
-// The 2D stress update's eigen-solve on its own (issue 6, proposal 1): principal Hencky strain
+// The 2D stress update's eigen-solve on its own: principal Hencky strain
 // and Kirchhoff stress of 250,000 elastic deformation gradients like the engine's (strains of
 // ~1e-3 in random frames, random rotations), per particle:
 //   hencky/2d/eigen        Eigen's SelfAdjointEigenSolver::computeDirect of F Fᵀ − I and

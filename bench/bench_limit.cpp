@@ -1,4 +1,4 @@
-// The limit kernel of issue 6: only the work no MLS-MPM step can avoid, for the particles of
+// The the limit kernel: only the work no MLS-MPM step can avoid, for the particles of
 // the benchmark scene (bench_scene.hpp, seeded by the engine itself, so the count and order
 // are the same as bench_step's). Per step:
 //  1. clear the grid (a fixed box around the particles, fitted once);
@@ -316,7 +316,7 @@ void limit_benchmark(benchmark::State& state, int threads, bool averaging) {
 }
 
 void register_all() {
-  // limit/…: the limit kernel of issue 6. limit_averaging/…: the same with the ΔJ-bar average
+  // limit/…: the limit kernel. limit_averaging/…: the same with the ΔJ-bar average
   // (grid_to_particle_averaged), what the engine's default scheme cannot avoid either.
   for (bool averaging : {false, true}) {
     for (int dim : {2, 3}) {

@@ -1,5 +1,5 @@
 #pragma once
-// The scene every benchmark runs (issue 6): a block of ice resting on a flat bed under
+// The scene every benchmark runs: a block of ice resting on a flat bed under
 // gravity, confined laterally by free-slip walls, with the geostatic initial stress (so it is
 // near equilibrium from the first step, like a settled glacier) and no settling phase. Elastic:
 // gravity, basal friction and walls only; softening adds the capped von Mises return mapping

@@ -1,4 +1,4 @@
-// Throughput of the engine's full step (issue 6): particle-steps per second of
+// Throughput of the engine's full step: particle-steps per second of
 // Simulation<Dim>::step() on the benchmark block (bench_scene.hpp), 2D and 3D, elastic and
 // softening, at 1 and 2 threads. Counters per case:
 //  * particle_steps_per_s (rate over wall time) and ns_<stage>: wall nanoseconds per

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Prints the benchmark table of issue 6 from the rounds that scripts/bench.sh ran.
+"""Prints the benchmark table from the rounds that scripts/bench.sh ran.
 
 Usage: bench_table.py DIR [--stages]
 

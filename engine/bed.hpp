@@ -18,6 +18,8 @@ class Bed {
   // top and flattening into the floor, as over a subglacial cauldron rim.
   static Bed concave(double x_top, double height, double length, double x_begin, double x_end);
   static Bed flat(double z0, double x_begin, double x_end);
+  // Any polyline with x non-decreasing, e.g. a snapshot's bed_profile.
+  static Bed polyline(std::vector<Point> vertices) { return Bed(std::move(vertices)); }
 
   double height_at(double x) const;  // z_b(x); the upper value on a vertical segment
   double signed_distance(double x, double z) const;

@@ -1,8 +1,8 @@
 #pragma once
-// Capped von Mises plasticity with a softening tensile cap (SPEC §3), returned in principal
+// Capped von Mises plasticity with a softening tensile cap (docs/model.md), returned in principal
 // Hencky strain space. With Hencky elasticity the volumetric and deviatoric parts decouple, so
 // the closest-point return onto {p ≥ p_c(ε_v^p), q ≤ q_y} is two independent clamps that
-// commute (research_physics.md §3.2):
+// commute (docs/model.md):
 //  * cap:   shift tr ε by −Δ (Δ/d on each principal strain), ε_v^p += Δ, p → p_c(ε_v^p + Δ);
 //  * shear: scale dev ε radially so that q = q_y (isochoric: tr ε unchanged).
 #include <algorithm>

@@ -1,7 +1,7 @@
 #pragma once
 // Hencky (logarithmic-strain) elasticity. With the left stretch of F_E written b = F_E F_Eᵀ =
 // U diag(Σ²) Uᵀ, the principal Hencky strains are ε = log Σ and the Kirchhoff stress is
-// τ = U (2μ ε + λ tr(ε) I) Uᵀ (SPEC §3). Only the symmetric eigenproblem of b is needed,
+// τ = U (2μ ε + λ tr(ε) I) Uᵀ (docs/model.md). Only the symmetric eigenproblem of b is needed,
 // never a full SVD of F_E: returning ε → ε' maps F_E to U diag(exp(ε' − ε)) Uᵀ F_E.
 #include <Eigen/Eigenvalues>
 #include <cmath>
@@ -20,7 +20,7 @@ struct ElasticModuli {
     m.lambda = youngs_modulus * poisson_ratio / ((1.0 + poisson_ratio) * (1.0 - 2.0 * poisson_ratio));
     return m;
   }
-  // Bulk modulus in the SPEC's d-dimensional convention: p = −tr(τ)/d = −K_d tr(ε).
+  // Bulk modulus in the d-dimensional convention of docs/model.md: p = −tr(τ)/d = −K_d tr(ε).
   double bulk(int dim) const { return lambda + 2.0 * mu / dim; }
   // P-wave modulus λ + 2μ, which sets the explicit time step.
   double p_wave_modulus() const { return lambda + 2.0 * mu; }
@@ -167,7 +167,7 @@ inline Vec<Dim> hencky_strain_from_kirchhoff(const ElasticModuli& m, const Vec<D
   return ((tau.array() - m.lambda * tr_eps) / (2.0 * m.mu)).matrix();
 }
 
-// SPEC invariants: p = −tr(τ)/d (compression positive), q = sqrt(3/2 dev τ : dev τ).
+// Invariants (docs/model.md): p = −tr(τ)/d (compression positive), q = sqrt(3/2 dev τ : dev τ).
 template <int Dim>
 inline double pressure_of(const Mat<Dim>& tau) {
   return -tau.trace() / Dim;

@@ -1,7 +1,7 @@
 #pragma once
 // Particle state as structure of arrays. Hot fields of the step (x, v, C, F_E, τ, mass, V0)
 // are always present; ε_v^p is allocated only when the scene names plasticity, so an elastic
-// scene carries no plastic storage (SPEC §4).
+// scene carries no plastic storage (docs/model.md).
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -53,7 +53,7 @@ struct Particles {
 
   // Reorders every array by `order`, a permutation of 0..size()−1 (order[i] = old index of the
   // new i-th particle). In place, cycle by cycle: the only extra memory is one bit per
-  // particle, so a sorting step holds no second copy of any array (issue 6: ≤ 200 B/particle
+  // particle, so a sorting step holds no second copy of any array (target ≤ 200 B/particle
   // at every step).
   void permute(const std::vector<std::uint32_t>& order) {
     std::vector<std::uint64_t> done((order.size() + 63) / 64);

@@ -196,7 +196,7 @@ void SceneConfig::resolve() {
   if (initial_stress != "geostatic" && initial_stress != "none")
     fail("ice.initial_stress", "value '" + initial_stress + "' is not 'geostatic' or 'none'");
 
-  // ζ: explicit, from G, or crack-band scaled from the reference (research_physics.md §3.4).
+  // ζ: explicit, from G, or crack-band scaled from the reference (docs/model.md).
   if (has(Effect::softening)) {
     check_range("ice.softening.zeta", softening_zeta, 0.0, 1e9);
     check_range("ice.softening.fracture_energy", fracture_energy, 0.0, 1e12);

@@ -11,7 +11,7 @@
 
 namespace crevasse {
 
-// What a scene calls for. The engine assembles its step from exactly these (SPEC §4).
+// What a scene calls for. The engine assembles its step from exactly these (docs/model.md).
 enum class Effect {
   gravity,              // body force
   drive,                // piston pushing the back face at drive_speed
@@ -37,7 +37,7 @@ struct SceneConfig {
   int dim = 2;
   std::vector<Effect> effects;
 
-  // Ice (SPEC §2 defaults)
+  // Ice (docs/model.md defaults)
   double density = 917.0;             // ρ_i [kg/m³]
   double youngs_modulus = 1.0e9;      // E [Pa]
   double poisson_ratio = 0.3;         // ν [-]
@@ -58,7 +58,7 @@ struct SceneConfig {
   double upstream_length = 0.0;       // slab length on the plateau [m]; 0 → 5·H_i
   // Ice already draped over the bed past the top of the step, horizontal length [m]: the
   // slab continues with its thickness H_i following the bed (surface z_b(x) + H_i). 0: the
-  // slab ends in a cliff at the top of the step (SPEC §2).
+  // slab ends in a cliff at the top of the step (docs/model.md).
   double draped_length = 0.0;
   double width = 0.0;                 // W_i [m] (3D); 0 → H_i
   std::array<double, 3> box_min{}, box_max{};  // body "box" extent [m]

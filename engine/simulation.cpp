@@ -26,7 +26,7 @@ namespace {
 // write 6 node columns, so slabs of one parity never share a node and run in parallel.
 constexpr int kSlabCells = 4;
 // Re-sorting particles by cell restores memory locality; every ~100 steps costs ~1% and never
-// costs ~17% (research_performance.md).
+// costs ~17% (docs/performance.md).
 constexpr int kSortInterval = 100;
 constexpr std::size_t kGrain = 1024;
 
@@ -80,7 +80,7 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
                                                     (scene_.step_height + scene_.ice_thickness)));
   }
 
-  // Assemble the step from the scene's effects (SPEC §4).
+  // Assemble the step from the scene's effects (docs/model.md).
   const double g = scene_.has(Effect::gravity) ? scene_.gravity : 0.0;
   Vec<Dim> gravity = Vec<Dim>::Zero();
   const double tilt = scene_.gravity_tilt_deg * std::numbers::pi / 180.0;
@@ -288,7 +288,7 @@ void Simulation<Dim>::seed_particles() {
   std::mt19937_64 rng(scene_.seed);
   std::uniform_real_distribution<double> jitter(-scene_.jitter * h, scene_.jitter * h);
 
-  // Geostatic initial stress (research_physics.md §1): σ_zz = −ρ g (s − z), lateral stresses
+  // Geostatic initial stress (docs/model.md): σ_zz = −ρ g (s − z), lateral stresses
   // K0·σ_zz with K0 = ν/(1 − ν), the uniaxial-strain state of a laterally confined slab. It is
   // loaded into F_E through the inverse Hencky law with τ = J σ (two fixed-point passes: J − 1
   // is of order 1e-3, so the second pass already changes τ by ~1e-6 relative).
@@ -770,7 +770,7 @@ void Simulation<Dim>::grid_to_particle() {
 // 1 − e^{−ζ ε_v^p}) and takes ΔJ_used = (1 − D)·ΔJ̄ + D·ΔJ_p. An opening crack then keeps its
 // volume change to itself instead of handing part of it to the intact ice around it, which
 // would widen every crack by a cell each time it opens further.
-// Three passes, fused with G2P (issue 6): (1) one coloured sweep gathers v and C and scatters
+// Three passes, fused with G2P: (1) one coloured sweep gathers v and C and scatters
 // (1 − D) m ΔJ and (1 − D) m with the same weights; (2) per node, the average; (3) the update
 // sweep interpolates ΔJ̄ back, recomputing ΔJ_p from C (unchanged since (1)). The softening
 // factor e^{−ζ ε_v^p} (= 1 − D) is kept per particle from (1) to (3), where the return mapping
@@ -1020,7 +1020,7 @@ template <int Dim>
 
 template <int Dim>
 void Simulation<Dim>::remove_outflow() {
-  // Ice within three cells of the downstream end has left the scene (SPEC §2).
+  // Ice within three cells of the downstream end has left the scene (docs/model.md).
   const double x_out = domain_hi_[0] - 3.0 * scene_.dx;
   auto& P = particles_;
   // Most steps remove nothing: look first (in parallel), allocate the mask only when needed.

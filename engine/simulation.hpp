@@ -1,5 +1,5 @@
 #pragma once
-// One explicit MLS-MPM simulation (SPEC §4). It owns all of its state; nothing is shared
+// One explicit MLS-MPM simulation (docs/model.md). It owns all of its state; nothing is shared
 // between simulations, so a study may run many at once. The step is a list of named, timed
 // stages assembled from the scene's effects in the constructor: an effect the scene does not
 // name adds no stage, and the material kernel (elastic or capped von Mises) is chosen once,

@@ -40,7 +40,7 @@ struct ParticleSnapshot {
   bool has_gate() const { return !gate_eps_v_p.empty(); }
 
   std::size_t size() const { return x.size(); }
-  // Fraction of strength lost, 1 − exp(−ζ ε_v^p) (SPEC §5); 0 with softening off.
+  // Fraction of strength lost, 1 − exp(−ζ ε_v^p) (docs/measurement.md); 0 with softening off.
   double damage(std::size_t i) const;
   // Front of the connected ice (Simulation::ice_front_x) when the engine filled it in (> 0);
   // scattered debris ahead of the ice does not move it.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Builds the benchmarks (Release, in build-bench) and prints the table of issue 6: the engine's
+# Builds the benchmarks (Release, in build-bench) and prints the benchmark table: the engine's
 # full step against the limit kernel, 2D/3D, elastic/softening, 1 and 2 threads, each number
 # the median of BENCH_REPETITIONS (5) interleaved rounds (bench/bench_table.py). Takes ~2 minutes
 # on 2 cores after the build. Timings on a shared machine are noisy: the load average before and

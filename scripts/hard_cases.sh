@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Runs the whole hard-case suite (issue 7, point 1; docs/reliability.md, "Hard cases"): every
+# Runs the whole hard-case suite (docs/reliability.md, "Hard cases"): every
 # test labelled `hard`, the long `hard;slow` ones and the disabled ones (known engine bugs)
 # included, one test at a time, and prints a table: case, steps, wall time, result.
 #

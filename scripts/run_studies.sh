@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates the regime studies in results/ (issue 8; results/README.md says what each file is):
+# Regenerates the regime studies in results/ (results/README.md says what each file is):
 # runs each study into results/<name>.db (resumable: run it again after an interruption and
 # finished cases are skipped), fits its laws into the database's fits table, draws its figures
 # into results/<name>_figures/ and, for the main study, runs the field calibration.

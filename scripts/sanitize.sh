@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The test suite under sanitizers (issue 7, part 4), from the presets in CMakePresets.json:
+# The test suite under sanitizers, from the presets in CMakePresets.json:
 #   asan: AddressSanitizer + UndefinedBehaviorSanitizer (any UB aborts), build-asan,
 #         then `ctest -LE slow` (every fast test, engine, analysis and study);
 #   tsan: ThreadSanitizer, build-tsan, then the concurrent runner and CLI tests (label study).

@@ -1,6 +1,6 @@
 #pragma once
 // `crevasse accuracy DB --out DIR`: accuracy against cost of a study that varies the numerics
-// (studies/accuracy_cost.json, SPEC §6, issue 6): per case the grid spacing, particles per cell,
+// (studies/accuracy_cost.json, docs/study_format.md): per case the grid spacing, particles per cell,
 // CFL number, drive speed V_x, steps, particle-steps, wall time and peak memory, the median spacing and depth
 // and their change against a reference case (by default the finest: the most particle-steps
 // among the cases with a spacing). Writes accuracy_cost.csv, accuracy_cost.md (the table) and

@@ -1,6 +1,6 @@
 #pragma once
 // Identity of a case: a SHA-256 of its canonical resolved parameters plus the engine version
-// (SPEC §6). Two cases that would compute the same thing get the same hash however their study
+// (docs/study_format.md). Two cases that would compute the same thing get the same hash however their study
 // files were written (key order, defaults spelled out or left implicit, group or dimensional
 // form), and any change that can alter a result gives a new hash.
 #include <nlohmann/json.hpp>

@@ -1,6 +1,6 @@
 #pragma once
-// The per-case results of a study database as the analysis reads them (SPEC §6): each case's
-// groups (SPEC §1), status, the quartiles of L_p/H_i and D_p/H_i, its spacings, and why a case
+// The per-case results of a study database as the analysis reads them (docs/study_format.md): each case's
+// groups (docs/model.md), status, the quartiles of L_p/H_i and D_p/H_i, its spacings, and why a case
 // has no value when it has none. Shared by `crevasse fit`, `plot`, `calibrate` and `predict`.
 #include <array>
 #include <cstdint>

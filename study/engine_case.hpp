@@ -1,6 +1,6 @@
 #pragma once
 // The real case function of the runner: simulate the case's scene with the engine, then
-// measure its crevasses (SPEC §5) at the end of the run.
+// measure its crevasses (docs/measurement.md) at the end of the run.
 #include "study/runner.hpp"
 
 namespace crevasse {

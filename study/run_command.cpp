@@ -128,7 +128,7 @@ int run_command(const RunCommandOptions& opt) {
   };
   std::ofstream(out / "run_summary.json") << summary.dump(2) << "\n";
 
-  // Crevasses at the end of the run (SPEC §5; in the gate frame when the scene records one,
+  // Crevasses at the end of the run (docs/measurement.md; in the gate frame when the scene records one,
   // docs/measurement.md), and the side views with each one marked.
   const analysis::CrevasseMeasurement m =
       analysis::measure_crevasses(r.final_snapshot, analysis::MeasureSettings{});

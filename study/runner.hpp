@@ -1,5 +1,5 @@
 #pragma once
-// Runs a study's cases (SPEC §6): skips the ones already stored, runs the rest concurrently on
+// Runs a study's cases (docs/study_format.md): skips the ones already stored, runs the rest concurrently on
 // TBB (each case in its own task arena of `threads_per_case` engine threads), survives failing
 // cases (recorded with their reason) and killed runs (rerun the same command: nothing stored is
 // lost, nothing finished is rerun), and reports progress to an observer the caller passes in.

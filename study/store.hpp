@@ -1,5 +1,5 @@
 #pragma once
-// The SQLite file of one study (SPEC §6; schema in docs/database.md): tables study, sessions,
+// The SQLite file of one study (docs/study_format.md; schema in docs/database.md): tables study, sessions,
 // cases, crevasses, summaries. WAL journal, so readers (crevasse status, sqlite3) never block the
 // writer and never see a half-written case; exactly one writer, enforced by an flock on
 // "<db>.lock" that the kernel releases even when the writer is killed. Every finished case is

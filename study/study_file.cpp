@@ -198,7 +198,7 @@ double number_in(const ordered_json& v, const std::string& field, const Range& r
   return x;
 }
 
-// The groups of a resolved scene (SPEC §1).
+// The groups of a resolved scene (docs/model.md).
 CaseGroups groups_of(const SceneConfig& s) {
   CaseGroups g;
   g.thickness_m = s.ice_thickness;
@@ -484,7 +484,7 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
     if (c.label.empty()) c.label = "base";
     const std::string where = "case " + std::to_string(index) + " (" + c.label + ")";
 
-    // Derived dimensional parameters (SPEC §1), written into these sections.
+    // Derived dimensional parameters (docs/model.md), written into these sections.
     for (const char* section : {"ice", "bed", "numerics", "run"})
       if (scene.contains(section) && !scene.at(section).is_object())
         fail(where,

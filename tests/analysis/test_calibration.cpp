@@ -29,7 +29,7 @@ PowerLawFit synthetic_study_fit(double a, double b, double sigma, int n, std::ui
 }
 
 TEST(CalibCohesionRatio, MatchesDefinition) {
-  // Π = c/(ρ g H) with the SPEC defaults; exact arithmetic up to round-off.
+  // Π = c/(ρ g H) with the default ρ_i, g; exact arithmetic up to round-off.
   EXPECT_NEAR(cohesion_ratio(1e5, 100.0), 1e5 / (kRhoG * 100.0), 1e-15);
   EXPECT_NEAR(cohesion_ratio(1e5, 100.0, {900.0, 10.0}), 1e5 / 9e5, 1e-15);
 }

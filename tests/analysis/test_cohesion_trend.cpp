@@ -1,4 +1,4 @@
-// Measurement on real simulations (issue 3, point 3): at the same H_i, stronger ice (larger Π)
+// Measurement on real simulations: at the same H_i, stronger ice (larger Π)
 // breaks into fewer, wider-spaced crevasses than weaker ice. The shipped H_i = 100 m scene
 // (cliff start, S = 1, dx = 10 m, stopped after 4 H_i through the gate) at Π = 0.2 and Π = 1,
 // measured in the gate frame. The quick study (results/quick.db, engine 0.3.0) gives median

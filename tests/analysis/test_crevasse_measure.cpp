@@ -1,4 +1,4 @@
-// Crevasse measurement on synthetic slabs whose crevasses are known exactly (SPEC §5).
+// Crevasse measurement on synthetic slabs whose crevasses are known exactly (docs/measurement.md).
 #include <gtest/gtest.h>
 
 #include <chrono>

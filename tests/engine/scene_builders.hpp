@@ -13,7 +13,7 @@
 
 namespace crevasse::test {
 
-// Ice properties shared by the tests (SPEC §2 defaults for E, ν, ρ).
+// Ice properties shared by the tests (docs/model.md defaults for E, ν, ρ).
 constexpr double kRho = 917.0;
 constexpr double kYoung = 1.0e9;
 constexpr double kPoisson = 0.3;

@@ -1,4 +1,4 @@
-// Checkpoints (issue 7, point 3): a simulation restored from a checkpoint continues bit for bit
+// Checkpoints: a simulation restored from a checkpoint continues bit for bit
 // as the uninterrupted one; a run cancelled and started again with the same checkpoint path ends
 // in the same state as a run never interrupted; a checkpoint of another scene or a truncated
 // file is refused.

@@ -1,4 +1,4 @@
-// Conservation laws of the transfer scheme (SPEC §4 stability requirements).
+// Conservation laws of the transfer scheme (docs/model.md stability requirements).
 //  * Mass: particles carry fixed masses, so without outflow the total is exactly the initial
 //    one, bit for bit, through sorting, bed contact, walls and plastic flow; with outflow,
 //    remaining + removed is the initial mass.

@@ -1,4 +1,4 @@
-// SPEC §4: the step is assembled from exactly the effects a scene names. An effect not named
+// docs/model.md: the step is assembled from exactly the effects a scene names. An effect not named
 // adds no stage and no per-particle storage; an elastic scene never runs the return mapping.
 #include <gtest/gtest.h>
 

@@ -121,7 +121,7 @@ TEST(ElasticColumn, BaseStress2dAgreesWith3d) {
   EXPECT_LT(rel, kColumnTolerance);
 }
 
-// SPEC §2: a fracture seen at t = 0 is a bug. With geostatic initial stress and the settling
+// docs/model.md: a fracture seen at t = 0 is a bug. With geostatic initial stress and the settling
 // phase, the column must start (and stay, while it does not move) free of plastic strain when
 // its tensile strength is well above the stress noise of the settled state. The noise is
 // measured here too: the largest tension (−p) of the settled column.

@@ -44,7 +44,7 @@ TEST(GlacierSmoke, IcePassesStepAndBreaksOnlyDownstream) {
   const double piston_zone = back + scene.ice_thickness;
   for (std::size_t i = 0; i < s.size(); ++i) {
     ASSERT_TRUE(std::isfinite(s.x[i]) && std::isfinite(s.z[i]) && std::isfinite(s.pressure_pa[i]));
-    const bool damaged = s.damage(i) >= 0.95;  // SPEC §5 damage threshold
+    const bool damaged = s.damage(i) >= 0.95;  // docs/measurement.md damage threshold
     if (s.x[i] < piston_zone) {
       damaged_piston += damaged;
     } else if (s.x[i] < upstream_limit) {

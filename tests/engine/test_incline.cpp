@@ -1,4 +1,4 @@
-// A block on a frictional incline (SPEC §2 bed contact; the Matter-style analytic regression):
+// A block on a frictional incline (docs/model.md bed contact; the Matter-style analytic regression):
 // gravity tilted by θ towards +x over a flat bed with Coulomb friction μ is a block on a slope.
 // When tan θ > μ it slides with a = g (sin θ − μ cos θ); when tan θ < μ it sticks.
 // The block starts in geostatic equilibrium (settled, with the vertical gravity g cos θ),

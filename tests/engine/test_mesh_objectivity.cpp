@@ -1,4 +1,4 @@
-// Mesh objectivity of the softening cap (SPEC §3): a bar pulled apart in uniaxial tension must
+// Mesh objectivity of the softening cap (docs/model.md): a bar pulled apart in uniaxial tension must
 // dissipate the same energy per unit crack area at every resolution when ζ is scaled with dx
 // (crack band: G = c·h/ζ with the band width h ∝ dx). The scene leaves softening_zeta = 0 so
 // that resolve() derives ζ = zeta_ref·dx/dx_ref.
@@ -99,7 +99,7 @@ TEST(MeshObjectivity, SameFractureEnergyAtDxAndHalfDx) {
 // "Mesh objectivity", has the numbers and the diagnosis: the band is 3 cells wide at dx and
 // dx/2; at dx/4 a tail of partial damage about 0.75 m wide forms beside it, of roughly fixed
 // physical width, whose energy grows as 1/dx with ζ ∝ dx: dx/8 gives +98%). The cause is the
-// cap's isotropic flow (SPEC §3): the band's plastic expansion across itself is held by the
+// cap's isotropic flow (docs/model.md): the band's plastic expansion across itself is held by the
 // ice beside it, so the axial stress through the band exceeds the cap and intact ice yields;
 // with the faces held the whole bar yields at dx/4 (+260 %).
 TEST(MeshObjectivity, DISABLED_SameFractureEnergyAtDxHalfDxQuarterDx) {

@@ -1,4 +1,4 @@
-// The piston (SPEC §2: the back face pushed at V_x) must stay behind the ice it pushes: the
+// The piston (docs/model.md: the back face pushed at V_x) must stay behind the ice it pushes: the
 // driven layer (particles with a drive_x0) may not move past the rearmost ice on the plateau.
 // docs/model.md, "The piston leaks into thick ice", has the measurements.
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
 // Capped von Mises return mapping in principal Hencky strain (engine/capped_von_mises.hpp),
-// checked against the definition of the yield surface (SPEC §3) rather than against stored
+// checked against the definition of the yield surface (docs/model.md) rather than against stored
 // numbers: admissibility of every returned state, exact volume preservation of the shear
 // return, the implicit cap return landing on p_c(ε_v^p + Δ), monotone ε_v^p, and a stable
 // return when the softening is steeper than the elastic unloading (cζ ≥ K, local snap-back),

@@ -1,5 +1,5 @@
 // Scene files are refused, with an InputError naming the field, when they contain unknown keys,
-// values of the wrong type or values outside the allowed range (SPEC §6: validation errors name
+// values of the wrong type or values outside the allowed range (docs/study_format.md: validation errors name
 // the field and the allowed range).
 #include <gtest/gtest.h>
 

@@ -118,7 +118,7 @@ void check_file(int dim, std::size_t n) {
     EXPECT_EQ(pts[3 * i + 1], dim == 3 ? snap.y[i] : 0.0);
     EXPECT_EQ(pts[3 * i + 2], snap.z[i]);
   }
-  // Damage is 1 − exp(−ζ ε_v^p) (SPEC §5).
+  // Damage is 1 − exp(−ζ ε_v^p) (docs/measurement.md).
   for (const Declared& d : arrays) {
     if (d.name != "damage") continue;
     std::vector<double> dmg(n);

@@ -1,4 +1,4 @@
-// Bad input on the command line (issue 7, part 2). Every file of the malformed-scene corpus
+// Bad input on the command line. Every file of the malformed-scene corpus
 // tests/inputs/bad_scenes/ makes `crevasse run` exit with code 2 and exactly one line on stderr
 // naming the field (expected.json maps each file to it), and writes no output. A bad study run
 // against an existing database leaves it byte-for-byte unchanged.

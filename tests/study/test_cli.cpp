@@ -121,7 +121,7 @@ std::int64_t done_count(const std::filesystem::path& db) {
   }
 }
 
-// Mid-case checkpoints (issue 7, point 3): one long case, SIGKILLed once its checkpoint exists;
+// Mid-case checkpoints: one long case, SIGKILLed once its checkpoint exists;
 // the resumed study continues it from the checkpoint (run_json.resumed_from_time_s > 0), deletes
 // the checkpoint, and stores the same result as an uninterrupted run.
 TEST(Cli, KilledCaseResumesFromItsCheckpoint) {

@@ -1,5 +1,5 @@
 #pragma once
-// Hard cases (issue 7, point 1; SPEC §4 "Stability"): runs a scene step by step and checks,
+// Hard cases (docs/model.md "Stability"): runs a scene step by step and checks,
 // while it runs and at the end, what a stable run must satisfy.
 //
 //  * finite: positions, velocities, F_E and the Kirchhoff stress of every particle;

@@ -1,4 +1,4 @@
-// Hard cases in a study (issue 7, point 1), label `hard`: a study holding a case pushed past
+// Hard cases in a study, label `hard`: a study holding a case pushed past
 // the stability limit records it as failed, with the engine's diagnosis as the reason, and
 // still completes the stable case next to it. The unstable case is CFL 2, the largest the scene
 // validation accepts (numerics.cfl in (0, 2]); the engine blows up there within a few steps

@@ -1,4 +1,4 @@
-// Nothing lost (issue 7): a study is SIGKILLed at random moments again and again (≥ 20 kills),
+// Nothing lost: a study is SIGKILLed at random moments again and again (≥ 20 kills),
 // resumed each time with the same command; afterwards the database passes integrity_check, no
 // finished case was lost, duplicated or rerun, and the contents equal an uninterrupted run.
 #include <fcntl.h>

@@ -1,4 +1,4 @@
-// Hard case, long run (issue 7, point 1), labels `hard;slow`: the base hard case of
+// Hard case, long run, labels `hard;slow`: the base hard case of
 // ../test_hard_cases.cpp run for 10× its usual simulated time T_u. The drive is slowed to
 // V_x/10 so that the ice makes the same journey (the piston stays on the plateau and the ice
 // stays in the domain) over ten times as many steps: what accumulates over a long run
