@@ -193,8 +193,9 @@ void SceneConfig::resolve() {
     fail("run", "give end_time, front_past_step, gate_length or max_steps, or the run never stops");
   if (has(Effect::softening) && !has(Effect::plasticity))
     fail("effects", "'softening' needs 'plasticity'");
-  if (initial_stress != "geostatic" && initial_stress != "none")
-    fail("ice.initial_stress", "value '" + initial_stress + "' is not 'geostatic' or 'none'");
+  if (initial_stress != "geostatic" && initial_stress != "hydrostatic" && initial_stress != "none")
+    fail("ice.initial_stress",
+         "value '" + initial_stress + "' is not 'geostatic', 'hydrostatic' or 'none'");
 
   // ζ: explicit, from G, or crack-band scaled from the reference (docs/model.md).
   if (has(Effect::softening)) {
@@ -214,7 +215,7 @@ void SceneConfig::resolve() {
   if (body == "slab") check_range("ice.thickness", ice_thickness, 0.0, 1e5, true);
   if (settle_time < 0.0) {
     const double h = body == "slab" ? ice_thickness : box_max[dim - 1] - box_min[dim - 1];
-    settle_time = (initial_stress == "geostatic" && has(Effect::gravity)) ? 30.0 * h / p_wave_speed() : 0.0;
+    settle_time = (initial_stress != "none" && has(Effect::gravity)) ? 30.0 * h / p_wave_speed() : 0.0;
   }
   check_range("ice.settle_time", settle_time, 0.0, 1e6);
   if (body == "slab") {

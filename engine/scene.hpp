@@ -62,7 +62,7 @@ struct SceneConfig {
   double draped_length = 0.0;
   double width = 0.0;                 // W_i [m] (3D); 0 → H_i
   std::array<double, 3> box_min{}, box_max{};  // body "box" extent [m]
-  std::string initial_stress = "geostatic";    // "geostatic" or "none"
+  std::string initial_stress = "geostatic";    // "geostatic", "hydrostatic" or "none"
   // Settling: the discrete MPM equilibrium differs slightly from the analytic geostatic state,
   // so an undamped start rings and puts the top particle layer into tension. Before t = 0 the
   // slab settles elastically (no return mapping, so no plastic strain), with the drive at rest

@@ -292,9 +292,13 @@ void Simulation<Dim>::seed_particles() {
   // K0·σ_zz with K0 = ν/(1 − ν), the uniaxial-strain state of a laterally confined slab. It is
   // loaded into F_E through the inverse Hencky law with τ = J σ (two fixed-point passes: J − 1
   // is of order 1e-3, so the second pass already changes τ by ~1e-6 relative).
-  const bool geostatic = scene_.initial_stress == "geostatic" && scene_.has(Effect::gravity);
+  // "hydrostatic" (K0 = 1) is the cryostatic state of ice that has flowed long enough for its
+  // deviatoric stress to relax: no shear stress at rest, so a low q_y does not yield at t = 0.
+  const bool geostatic = scene_.initial_stress != "none" && scene_.has(Effect::gravity);
   const double g_vertical = scene_.gravity * std::cos(scene_.gravity_tilt_deg * std::numbers::pi / 180.0);
-  const double k0 = scene_.poisson_ratio / (1.0 - scene_.poisson_ratio);
+  const double k0 = scene_.initial_stress == "hydrostatic"
+                        ? 1.0
+                        : scene_.poisson_ratio / (1.0 - scene_.poisson_ratio);
   const double cell_volume = std::pow(h, Dim);
 
   std::size_t total = 1;

@@ -66,6 +66,29 @@ TEST(FlowingGlacier, DrapedGlacierWithoutDriveShowsNoDamageAfterSettling) {
   EXPECT_LE(sim.max_yield_violation(), 1e-9);
 }
 
+// "hydrostatic" loads the cryostatic state σ = −ρ g (s − z) I: no deviatoric stress at rest, so a
+// shear strength below the K0 state's q = (1 − 2ν)/(1 − ν)·ρ g (s − z) does not yield at t = 0.
+TEST(FlowingGlacier, HydrostaticStartHasNoDeviatoricStress) {
+  nlohmann::json j = test::shipped_scene_json("flowing_2d.json");
+  j["ice"]["initial_stress"] = "hydrostatic";
+  const SceneConfig scene = scene_from_json(j);
+  Simulation<2> sim(scene);
+  const auto& P = sim.particles();
+  const double rho_g = scene.density * scene.gravity;
+  const double top = scene.step_height + scene.ice_thickness;
+  int checked = 0;
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    if (P.x[p][0] > scene.step_top_x() - scene.dx) continue;  // the plateau, where s = H_s + H_i
+    const double j_det = P.F_e[p].determinant();
+    const double expected = -rho_g * (top - P.x[p][1]);
+    ASSERT_NEAR(P.tau[p](0, 0) / j_det, expected, 1e-6 * rho_g * scene.ice_thickness) << p;
+    ASSERT_NEAR(P.tau[p](1, 1) / j_det, expected, 1e-6 * rho_g * scene.ice_thickness) << p;
+    ASSERT_EQ(P.tau[p](0, 1), 0.0) << p;
+    ++checked;
+  }
+  EXPECT_GT(checked, 100);
+}
+
 // The gate past the lip records only ice that crosses it: the draped ice that starts past it is
 // never recorded, so the passed length starts at 0 and grows with the ice's advance V_x·t.
 TEST(FlowingGlacier, GateCountsOnlyIceThatCrossesIt) {

@@ -105,7 +105,7 @@ TEST(SceneValidation, OutOfRangeValuesAreRefused) {
       {"numerics", "particles_per_cell_axis", 0, "numerics.particles_per_cell_axis"},
       {"bed", "friction", -0.1, "bed.friction"},
       {"bed", "shape", "ramp", "bed.shape"},
-      {"ice", "initial_stress", "hydrostatic", "ice.initial_stress"},
+      {"ice", "initial_stress", "lithostatic", "ice.initial_stress"},
   };
   for (const Case& c : cases) {
     json j = valid_scene();
