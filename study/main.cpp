@@ -48,6 +48,12 @@ const CLI::Validator kFinite(
     },
     "FINITE");
 
+// An empty path or name is never meant: `--out ''` wrote into the current folder and `--db ''`
+// fell back to the default database. Every text option and argument refuses it.
+const CLI::Validator kNonEmpty(
+    [](std::string& s) -> std::string { return s.empty() ? std::string("empty value") : std::string(); },
+    "");
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -146,6 +152,9 @@ int main(int argc, char** argv) {
     return std::string("crevasse: error: ") + e.what() + "\n";
   });
 
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
+    for (CLI::Option* o : sub->get_options())
+      if (o->get_type_name().rfind("TEXT", 0) == 0) o->check(kNonEmpty);
   try {
     app.parse(argc, argv);
     if (*run) return crevasse::run_command(run_opt);

@@ -78,6 +78,42 @@ TEST(Cli, EveryFloatingPointOptionRefusesNonFiniteValues) {
   EXPECT_GE(checked, 10);  // vtu/measure interval, case time limit, levels, spacing, thickness, cohesion
 }
 
+// Every text option and positional argument of every subcommand, as its --help lists them,
+// refuses an empty value with exit 2 and a line naming it, and writes nothing (`run --out ''`
+// wrote into the current folder; `study --db ''` fell back to the default database).
+TEST(Cli, EveryTextOptionRefusesAnEmptyValue) {
+  test::ScratchDir dir("cli_empty");
+  const Result top = run_cli(dir.path(), "--help");
+  const std::regex subcommand_line(R"(^  ([a-z]+)  )");
+  const std::regex text_item(R"(^  (--[a-z-]+|[a-z]+) TEXT)");
+  int checked = 0;
+  std::istringstream top_lines(top.out);
+  for (std::string line; std::getline(top_lines, line);) {
+    std::smatch sub;
+    if (!std::regex_search(line, sub, subcommand_line)) continue;
+    const Result help = run_cli(dir.path(), sub[1].str() + " --help");
+    std::istringstream help_lines(help.out);
+    std::string positionals_before;  // a placeholder for each earlier positional
+    for (std::string item; std::getline(help_lines, item);) {
+      std::smatch m;
+      if (!std::regex_search(item, m, text_item)) continue;
+      const std::string name = m[1].str();
+      const bool positional = name.rfind("--", 0) != 0;
+      const std::string args = sub[1].str() + " " + (positional ? positionals_before + "''" : name + " ''");
+      const Result r = run_cli(dir.path(), args);
+      EXPECT_EQ(r.code, 2) << args;
+      EXPECT_NE(r.err.find(name + ": empty value"), std::string::npos) << args << ": " << r.err;
+      if (positional) positionals_before += "x.db ";
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 30);
+  int entries = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir.path()))
+    entries += e.path().filename() != "cli_out.txt" && e.path().filename() != "cli_err.txt";
+  EXPECT_EQ(entries, 0);
+}
+
 TEST(Cli, RunMeasuresAtIntervalsWhenAsked) {
   test::ScratchDir dir("cli");
   nlohmann::json scene = test::tiny_scene();
