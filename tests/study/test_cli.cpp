@@ -48,29 +48,34 @@ TEST(Cli, InvalidStudyFilesExitWithCode2AndCreateNoDatabase) {
   EXPECT_EQ(run_cli(dir.path(), "status no_such.db").code, 2);
 }
 
-// crevasse run --measure-interval: one row per interval of simulated time plus the final
-// measurement, in time order, with the gate frame for a slab on a step.
+// Each subcommand's name and --help text, in the order the top-level --help lists them.
+std::vector<std::pair<std::string, std::string>> subcommand_helps(const std::filesystem::path& dir) {
+  const std::regex subcommand_line(R"(^  ([a-z]+)  )");
+  std::vector<std::pair<std::string, std::string>> helps;
+  std::istringstream lines(run_cli(dir, "--help").out);
+  for (std::string line; std::getline(lines, line);) {
+    std::smatch sub;
+    if (std::regex_search(line, sub, subcommand_line))
+      helps.emplace_back(sub[1].str(), run_cli(dir, sub[1].str() + " --help").out);
+  }
+  return helps;
+}
+
 // Every floating-point option of every subcommand, as its --help lists them (CLI11 names their
 // type FLOAT), refuses NaN, infinities and overflow with exit 2 and a line naming the option: a
 // range check alone lets NaN through, and a new option is covered without editing this test.
 TEST(Cli, EveryFloatingPointOptionRefusesNonFiniteValues) {
   test::ScratchDir dir("cli_finite");
-  const Result top = run_cli(dir.path(), "--help");
-  const std::regex subcommand_line(R"(^  ([a-z]+)  )");
   const std::regex float_option(R"((--[a-z-]+) FLOAT)");
   int checked = 0;
-  std::istringstream top_lines(top.out);
-  for (std::string line; std::getline(top_lines, line);) {
-    std::smatch sub;
-    if (!std::regex_search(line, sub, subcommand_line)) continue;
-    const Result help = run_cli(dir.path(), sub[1].str() + " --help");
-    for (std::sregex_iterator it(help.out.begin(), help.out.end(), float_option), end; it != end; ++it) {
+  for (const auto& [sub, help] : subcommand_helps(dir.path())) {
+    for (std::sregex_iterator it(help.begin(), help.end(), float_option), end; it != end; ++it) {
       const std::string option = (*it)[1].str();
       for (const std::string value : {"nan", "inf", "-inf", "1e400"}) {
-        const Result r = run_cli(dir.path(), sub[1].str() + " " + option + " " + value);
-        EXPECT_EQ(r.code, 2) << sub[1] << " " << option << " " << value;
+        const Result r = run_cli(dir.path(), sub + " " + option + " " + value);
+        EXPECT_EQ(r.code, 2) << sub << " " << option << " " << value;
         EXPECT_NE(r.err.find(option + ": '" + value + "' is not a finite number"), std::string::npos)
-            << sub[1] << " " << option << " " << value << ": " << r.err;
+            << sub << " " << option << " " << value << ": " << r.err;
       }
       ++checked;
     }
@@ -83,23 +88,17 @@ TEST(Cli, EveryFloatingPointOptionRefusesNonFiniteValues) {
 // wrote into the current folder; `study --db ''` fell back to the default database).
 TEST(Cli, EveryTextOptionRefusesAnEmptyValue) {
   test::ScratchDir dir("cli_empty");
-  const Result top = run_cli(dir.path(), "--help");
-  const std::regex subcommand_line(R"(^  ([a-z]+)  )");
   const std::regex text_item(R"(^  (--[a-z-]+|[a-z]+) TEXT)");
   int checked = 0;
-  std::istringstream top_lines(top.out);
-  for (std::string line; std::getline(top_lines, line);) {
-    std::smatch sub;
-    if (!std::regex_search(line, sub, subcommand_line)) continue;
-    const Result help = run_cli(dir.path(), sub[1].str() + " --help");
-    std::istringstream help_lines(help.out);
+  for (const auto& [sub, help] : subcommand_helps(dir.path())) {
+    std::istringstream help_lines(help);
     std::string positionals_before;  // a placeholder for each earlier positional
     for (std::string item; std::getline(help_lines, item);) {
       std::smatch m;
       if (!std::regex_search(item, m, text_item)) continue;
       const std::string name = m[1].str();
       const bool positional = name.rfind("--", 0) != 0;
-      const std::string args = sub[1].str() + " " + (positional ? positionals_before + "''" : name + " ''");
+      const std::string args = sub + " " + (positional ? positionals_before + "''" : name + " ''");
       const Result r = run_cli(dir.path(), args);
       EXPECT_EQ(r.code, 2) << args;
       EXPECT_NE(r.err.find(name + ": empty value"), std::string::npos) << args << ": " << r.err;
@@ -114,6 +113,8 @@ TEST(Cli, EveryTextOptionRefusesAnEmptyValue) {
   EXPECT_EQ(entries, 0);
 }
 
+// crevasse run --measure-interval: one row per interval of simulated time plus the final
+// measurement, in time order, with the gate frame for a slab on a step.
 TEST(Cli, RunMeasuresAtIntervalsWhenAsked) {
   test::ScratchDir dir("cli");
   nlohmann::json scene = test::tiny_scene();
