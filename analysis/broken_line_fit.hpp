@@ -1,6 +1,6 @@
 #pragma once
 // Continuous two-segment ("broken-line") fit in log-log space, for a law that changes exponent
-// between two regimes (docs/study_format.md), and its comparison with a single power law. Equations,
+// between two regimes, and its comparison with a single power law. Equations,
 // the breakpoint interval and the comparison rule are in docs/fits.md.
 #include <array>
 #include <cstddef>

@@ -1,5 +1,5 @@
 #pragma once
-// Calibration (docs/study_format.md): the study's laws L_p/H_i = a·Π^b and D_p/H_i = a·Π^b with
+// Calibration (docs/fits.md §5): the study's laws L_p/H_i = a·Π^b and D_p/H_i = a·Π^b with
 // Π = c/(ρ_i g H_i), used forwards (predict spacing and depth for a given c and H_i) and
 // backwards (estimate the tensile strength c from an observed crevasse spacing). Method and
 // assumptions: docs/fits.md.

@@ -1,6 +1,6 @@
 #pragma once
-// Crevasse positions, depths and spacings from a particle snapshot (docs/measurement.md,
-// docs/measurement.md). Definitions and the reasons for each default: docs/measurement.md.
+// Crevasse positions, depths and spacings from a particle snapshot.
+// Definitions and the reasons for each default: docs/measurement.md.
 #include <cstddef>
 #include <optional>
 #include <string>
@@ -24,7 +24,7 @@ struct MeasureSettings {
   //   "gate":  the damage each particle carried when it reached the top of the step, drawn at
   //            its initial position — the fracture pattern the ice took over the step, before
   //            falling blocks shatter on the floor. Needs a snapshot with gate records.
-  //   "final": the particles where they are at the snapshot's time (docs/measurement.md as written).
+  //   "final": the particles where they are at the snapshot's time.
   //   "auto":  "gate" when the snapshot has gate records, else "final".
   std::string frame = "auto";
 

@@ -1,5 +1,5 @@
 #pragma once
-// Power law y = a·x^b fitted by ordinary least squares in log space (docs/study_format.md). The model and
+// Power law y = a·x^b fitted by ordinary least squares in log space. The model and
 // the interval formulas are written out in docs/fits.md.
 #include <array>
 #include <cstddef>

@@ -1,5 +1,5 @@
 #pragma once
-// The study figures of docs/study_format.md: the log-log regime diagram (L_p/H_i or D_p/H_i against Π, with
+// The study figures (docs/fits.md §6): the log-log regime diagram (L_p/H_i or D_p/H_i against Π, with
 // quartile bars, failed cases, the fitted law(s), 95 % bands and the breakpoint interval) and
 // empirical CDFs of several samples. Both return a Figure to write as PNG and/or SVG.
 #include <limits>

@@ -1,5 +1,5 @@
 #pragma once
-// `crevasse calibrate` and `crevasse predict` (docs/study_format.md, docs/fits.md §5): the study's laws of
+// `crevasse calibrate` and `crevasse predict` (docs/fits.md §5): the study's laws of
 // L_p/H_i (and D_p/H_i) against Π = c/(ρ_i g H_i), inverted to estimate the tensile strength c
 // from an observed crevasse spacing, or used forwards to predict spacing and depth for a given c
 // and H_i. The laws are the rows of the database's `fits` table (crevasse fit); when the table

@@ -37,7 +37,7 @@ std::string one_line(const char* what) {
 }
 
 // CLI11's Range lets NaN through (every comparison with NaN is false), and "inf" or "1e400" reach
-// the commands as infinities: every floating-point option is first required to be finite.
+// the commands as infinities: every floating-point option is required to be finite.
 const CLI::Validator kFinite(
     [](std::string& s) -> std::string {
       char* end = nullptr;
@@ -64,8 +64,8 @@ int main(int argc, char** argv) {
   auto* run = app.add_subcommand("run", "Simulate one scene: VTU snapshots, side-view PNG, crevasse measurement");
   run->add_option("scene", run_opt.scene_path, "Scene JSON file (see README, studies/scenes/)")->required();
   run->add_option("--out", run_opt.out_dir, "Output directory")->required();
-  run->add_option("--vtu-interval", run_opt.vtu_interval, "Simulated seconds between VTU snapshots (overrides the scene)")->check(kFinite)->check(CLI::Range(0.0, 1e9));
-  run->add_option("--measure-interval", run_opt.measure_interval, "Also measure the crevasses every this many simulated seconds, to see whether the pattern has settled (measurements_over_time.csv)")->check(kFinite)->check(CLI::Range(0.0, 1e9));
+  run->add_option("--vtu-interval", run_opt.vtu_interval, "Simulated seconds between VTU snapshots (overrides the scene)")->check(CLI::Range(0.0, 1e9));
+  run->add_option("--measure-interval", run_opt.measure_interval, "Also measure the crevasses every this many simulated seconds, to see whether the pattern has settled (measurements_over_time.csv)")->check(CLI::Range(0.0, 1e9));
   run->add_option("--threads", run_opt.threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 1024));
   run->add_flag("--quiet", run_opt.quiet, "No progress output");
 
@@ -75,7 +75,7 @@ int main(int argc, char** argv) {
   study->add_option("--db", study_opt.db_path, "Database (default results/<name>.db)");
   study->add_option("--jobs", study_opt.jobs, "Cases at once (default: cores / threads per case)")->check(CLI::Range(1, 1024));
   study->add_option("--threads-per-case", study_opt.threads_per_case, "Engine threads per case (default 1)")->check(CLI::Range(1, 1024));
-  study->add_option("--case-time-limit", study_opt.case_time_limit_s, "Wall seconds per case, 0 = none (default: the study's resources)")->check(kFinite)->check(CLI::Range(0.0, 1e8));
+  study->add_option("--case-time-limit", study_opt.case_time_limit_s, "Wall seconds per case, 0 = none (default: the study's resources)")->check(CLI::Range(0.0, 1e8));
   study->add_option("--shard", study_opt.shard, "Run only shard I of N (I/N, 0 <= I < N)");
   study->add_flag("--fail-fast", study_opt.fail_fast, "Stop at the first failing case");
   study->add_flag("--retry-failed", study_opt.retry_failed, "Run cases stored as failed again");
@@ -104,7 +104,7 @@ int main(int argc, char** argv) {
   fit->add_option("--group", fit_opt.groups, "Group on the horizontal axis (repeatable; 'all' = every group that varies; default cohesion_ratio)");
   fit->add_option("--fixed-exponents", fit_opt.fixed_exponents, "Broken line of L_p/H_i: exponents below,above the breakpoint, each a number or 'free' (e.g. 1,free)");
   fit->add_option("--fixed-depth-exponents", fit_opt.fixed_depth_exponents, "The same for D_p/H_i");
-  fit->add_option("--level", fit_opt.level, "Confidence level of the intervals (default 0.95)")->check(kFinite);
+  fit->add_option("--level", fit_opt.level, "Confidence level of the intervals (default 0.95)");
   fit->add_flag("--exclude-fragmented", fit_opt.exclude_fragmented, "Leave out cases flagged fragmented");
   fit->add_flag("--no-store", fit_opt.no_store, "Print the table only; do not write the fits table");
 
@@ -126,19 +126,19 @@ int main(int argc, char** argv) {
   std::optional<double> calibrate_thickness;
   auto* calibrate = app.add_subcommand("calibrate", "Estimate the tensile strength c from an observed crevasse spacing");
   calibrate->add_option("--db", calibrate_opt.db_path, "Study database (its fits table, or fits made now)")->required();
-  calibrate->add_option("--spacing", calibrate_opt.spacing_m, "Observed median crevasse spacing L_p [m]")->check(kFinite);
+  calibrate->add_option("--spacing", calibrate_opt.spacing_m, "Observed median crevasse spacing L_p [m]");
   calibrate->add_option("--spacing-quartiles", calibrate_opt.spacing_quartiles, "Observed spacing quartiles Q25,Q75 [m]");
-  calibrate->add_option("--thickness", calibrate_thickness, "Ice thickness H_i at the site [m]")->check(kFinite);
-  calibrate->add_option("--level", calibrate_opt.level, "Confidence level (default 0.95)")->check(kFinite);
+  calibrate->add_option("--thickness", calibrate_thickness, "Ice thickness H_i at the site [m]");
+  calibrate->add_option("--level", calibrate_opt.level, "Confidence level (default 0.95)");
   calibrate->add_option("--observations", calibrate_opt.observations_path, "Field observations file (studies/field/observations.json): every site as a table, instead of --spacing");
   calibrate->add_option("--csv", calibrate_opt.csv_path, "With --observations: write the table as CSV too");
 
   crevasse::PredictCommandOptions predict_opt;
   auto* predict = app.add_subcommand("predict", "Predict crevasse spacing and depth for a tensile strength and thickness");
   predict->add_option("--db", predict_opt.db_path, "Study database (its fits table, or fits made now)")->required();
-  predict->add_option("--cohesion", predict_opt.tensile_strength_pa, "Tensile strength c [Pa]")->required()->check(kFinite);
-  predict->add_option("--thickness", predict_opt.thickness_m, "Ice thickness H_i [m]")->required()->check(kFinite);
-  predict->add_option("--level", predict_opt.level, "Confidence level (default 0.95)")->check(kFinite);
+  predict->add_option("--cohesion", predict_opt.tensile_strength_pa, "Tensile strength c [Pa]")->required();
+  predict->add_option("--thickness", predict_opt.thickness_m, "Ice thickness H_i [m]")->required();
+  predict->add_option("--level", predict_opt.level, "Confidence level (default 0.95)");
 
   crevasse::AccuracyCommandOptions accuracy_opt;
   auto* accuracy = app.add_subcommand("accuracy", "Accuracy against cost of a study over the numerics (studies/accuracy_cost.json): table and figure");
@@ -154,7 +154,11 @@ int main(int argc, char** argv) {
 
   for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
     for (CLI::Option* o : sub->get_options())
-      if (o->get_type_name().rfind("TEXT", 0) == 0) o->check(kNonEmpty);
+      if (o->get_type_name().rfind("TEXT", 0) == 0) {
+        o->check(kNonEmpty);
+      } else if (o->get_type_name().rfind("FLOAT", 0) == 0) {
+        o->check(kFinite);
+      }
   try {
     app.parse(argc, argv);
     if (*run) return crevasse::run_command(run_opt);

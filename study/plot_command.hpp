@@ -1,5 +1,5 @@
 #pragma once
-// `crevasse plot DB --out DIR`: the study's figures (docs/study_format.md, docs/fits.md §6) as PNG and SVG:
+// `crevasse plot DB --out DIR`: the study's figures (docs/fits.md §6) as PNG and SVG:
 // regime diagrams of median L_p/H_i and D_p/H_i against Π (or another group) with the fitted
 // law(s), and empirical CDFs of the spacings of chosen cases.
 #include <cstdint>

@@ -1,6 +1,6 @@
 #pragma once
-// A study file (docs/study_format.md, docs/study_format.md): a base scene, fixed parameters and sweep axes
-// over the dimensionless groups of docs/model.md (or any scene parameter by JSON pointer), replicas,
+// A study file (docs/study_format.md): a base scene, fixed parameters and sweep axes
+// over the dimensionless groups (or any scene parameter by JSON pointer), replicas,
 // measurement settings and resources. Loading it enumerates every case (Cartesian product of
 // the axes × replicas), derives the dimensional parameters (c = Π ρ_i g H_i, L_s = r·H_i,
 // H_s = S·L_s or h·H_i, W_i = w·H_i), resolves and validates each case's scene, and hashes it.

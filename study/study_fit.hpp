@@ -1,5 +1,5 @@
 #pragma once
-// Fits of one study's per-case medians (L_p/H_i or D_p/H_i) against one group (docs/study_format.md): a
+// Fits of one study's per-case medians (L_p/H_i or D_p/H_i) against one group (docs/fits.md §7): a
 // single power law and a continuous broken line with its comparison (docs/fits.md), with an
 // account of every case that was not fitted and why. Too little data is not an error here: the
 // fit is absent and `*_problem` says why, so that the table can show a "not enough data" row.

@@ -1,4 +1,4 @@
-// Hard cases (docs/model.md "Stability"), label `hard`: small glaciers pushed over
+// Hard cases (docs/model.md, "Numerics"), label `hard`: small glaciers pushed over
 // a step at the edges of the parameter space, each varying one group of the base case, and
 // asserting the checks of hard_case.hpp (finite state, mass budget with the outflow, nothing
 // outside the domain, kinetic energy ≤ k·E_drive and every speed ≤ v_max, Φ/c ≤ 1e-6 at the
