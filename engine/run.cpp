@@ -127,6 +127,7 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
   out.sim_time_s = sim.time();
   out.final_mass = sim.total_mass();
   out.removed_mass = sim.removed_mass();
+  out.inflow_mass = sim.inflow_mass();
   out.final_particles = sim.particles().size();
   out.final_snapshot = sim.snapshot();
   out.final_ice_front_x = sim.ice_front_x();

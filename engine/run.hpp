@@ -77,6 +77,7 @@ struct RunSummary {
   double initial_mass = 0.0;
   double final_mass = 0.0;
   double removed_mass = 0.0;
+  double inflow_mass = 0.0;  // entered through the inflow boundary
   std::size_t initial_particles = 0;
   std::size_t final_particles = 0;
   nlohmann::json stage_seconds;  // per stage: seconds and calls

@@ -183,6 +183,10 @@ void SceneConfig::resolve() {
   check_range("drive.ramp_time", drive_ramp_time, 0.0, 1e6);
   if (drive_start != "ramp" && drive_start != "moving")
     fail("drive.start", "value '" + drive_start + "' is not 'ramp' or 'moving'");
+  if (drive_boundary != "piston" && drive_boundary != "inflow")
+    fail("drive.boundary", "value '" + drive_boundary + "' is not 'piston' or 'inflow'");
+  if (drive_boundary == "inflow" && (body != "slab" || !has(Effect::drive)))
+    fail("drive.boundary", "'inflow' needs ice.body 'slab' and the 'drive' effect");
   check_range("bed.friction", bed_friction, 0.0, 10.0);
   check_range("run.end_time", end_time, 0.0, 1e9);
   check_range("run.front_past_step", front_past_step, 0.0, 1e9);
@@ -267,7 +271,8 @@ void SceneConfig::resolve() {
   if (gate_length != 0.0) {
     if (!records_gate())
       fail("run.gate_length", "needs a slab on a 'step' or 'concave' bed with the 'plasticity' effect");
-    check_range("run.gate_length", gate_length, 0.0, upstream_length, true);
+    // A piston consumes the slab behind the step; an inflow feeds it without end.
+    if (drive_boundary == "piston") check_range("run.gate_length", gate_length, 0.0, upstream_length, true);
   }
   check_range("run.gate_offset", gate_offset, 0.0, body == "slab" ? step_length + downstream_length - 8.0 * dx : 0.0);
   if (has(Effect::downstream_drive)) {
@@ -363,6 +368,7 @@ SceneConfig scene_from_json(const nlohmann::json& j) {
     o.number("speed", s.drive_speed);
     o.number("ramp_time", s.drive_ramp_time);
     o.string("start", s.drive_start);
+    o.string("boundary", s.drive_boundary);
     o.refuse_unknown();
   }
   if (const auto* g = r.child("gravity")) {
@@ -475,7 +481,7 @@ nlohmann::json scene_to_json(const SceneConfig& s) {
         {"downstream_length", s.downstream_length},
         {"friction", s.bed_friction},
         {"z", s.flat_bed_z}}},
-      {"drive", {{"speed", s.drive_speed}, {"ramp_time", s.drive_ramp_time}, {"start", s.drive_start}}},
+      {"drive", {{"speed", s.drive_speed}, {"ramp_time", s.drive_ramp_time}, {"start", s.drive_start}, {"boundary", s.drive_boundary}}},
       {"gravity", {{"g", s.gravity}, {"tilt_deg", s.gravity_tilt_deg}}},
       {"numerics",
        {{"dx", s.dx},

@@ -148,6 +148,7 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   particle_effects_.push_back("domain_clamp");
   if (scene_.records_gate()) add_stage("gate", [this] { record_gate(); });
   if (scene_.has(Effect::outflow)) add_stage("outflow", [this] { remove_outflow(); });
+  if (scene_.drive_boundary == "inflow") add_stage("inflow", [this] { inflow(); });
   add_stage("time_step", [this] { update_time_step(); });
 
   update_time_step();
@@ -294,7 +295,7 @@ void Simulation<Dim>::seed_particles() {
   // is of order 1e-3, so the second pass already changes τ by ~1e-6 relative).
   // "hydrostatic" (K0 = 1) is the cryostatic state of ice that has flowed long enough for its
   // deviatoric stress to relax: no shear stress at rest, so a low q_y does not yield at t = 0.
-  const bool geostatic = scene_.initial_stress != "none" && scene_.has(Effect::gravity);
+  const bool prestressed = scene_.initial_stress != "none" && scene_.has(Effect::gravity);
   const double g_vertical = scene_.gravity * std::cos(scene_.gravity_tilt_deg * std::numbers::pi / 180.0);
   const double k0 = scene_.initial_stress == "hydrostatic"
                         ? 1.0
@@ -324,7 +325,7 @@ void Simulation<Dim>::seed_particles() {
     Mat<Dim> fe = Mat<Dim>::Identity();
     Mat<Dim> tau = Mat<Dim>::Zero();
     double vol0 = cell_volume;
-    if (geostatic) {
+    if (prestressed) {
       Vec<Dim> sigma = Vec<Dim>::Constant(-k0 * rho * g_vertical * (surface_z - pos[up_axis<Dim>]));
       sigma[up_axis<Dim>] = -rho * g_vertical * (surface_z - pos[up_axis<Dim>]);
       Vec<Dim> tau_p = sigma;
@@ -1050,6 +1051,57 @@ void Simulation<Dim>::remove_outflow() {
 }
 
 template <int Dim>
+std::int64_t Simulation<Dim>::inflow_columns_due(double s) const {
+  return static_cast<std::int64_t>(std::floor(s * scene_.particles_per_cell_axis / scene_.dx));
+}
+
+template <int Dim>
+void Simulation<Dim>::inflow() {
+  // The back layer (x < dx at the start, one cell) stays where it is, moved along x at the drive
+  // speed by finish_particle and drive_grid_nodes like the piston. Each time the drive has moved
+  // by one particle spacing h, the band of driven ice h wide just inside the layer is copied h
+  // further back, into the place it has vacated: the same stress, mass and vertical position, so
+  // the ice enters already settled and loaded, with no step in its state. Driven ice that has
+  // passed the layer's downstream face (x ≥ dx) is released to move freely.
+  if (settling_) return;
+  auto& P = particles_;
+  const double h = scene_.dx / scene_.particles_per_cell_axis;
+  const double s = scene_.drive_position(time_);
+  const std::int64_t due = inflow_columns_due(s);
+  const std::size_t n0 = P.size();
+  for (; inflow_columns_ < due; ++inflow_columns_) {
+    // The band of column k = inflow_columns_ + 1 at its crossing (s = k h): x ∈ [h, 2h).
+    const double k = static_cast<double>(inflow_columns_ + 1);
+    const double lo = (1.0 - k) * h, hi = (2.0 - k) * h;
+    const std::size_t n = P.size();
+    for (std::size_t q = 0; q < n; ++q) {
+      const double d0 = P.drive_x0[q];
+      if (!(d0 >= lo && d0 < hi)) continue;  // NaN (released) fails both
+      Vec<Dim> pos = P.x[q];
+      pos[0] = d0 - h + s;
+      P.push_back(pos, P.mass[q], P.vol0[q], P.F_e[q], P.tau[q]);
+      P.v.back() = P.v[q];
+      P.drive_x0.push_back(d0 - h);
+      if (P.has_plastic_state()) P.eps_v_p.push_back(0.0);
+      if (records_gate()) {
+        // The gate frame's "initial position": where this ice would have been at t = 0 had the
+        // slab reached that far upstream, so the recorded field stays one continuous glacier.
+        std::array<float, Dim> ref;
+        for (int a = 0; a < Dim; ++a) ref[a] = static_cast<float>(pos[a]);
+        ref[0] = static_cast<float>(d0 - h);
+        P.x_ref.push_back(ref);
+        P.gate_eps.push_back(kGateNotYet);
+      }
+      inflow_mass_ += P.mass[q];
+    }
+  }
+  for (std::size_t p = 0; p < n0; ++p)
+    if (!std::isnan(P.drive_x0[p]) && P.drive_x0[p] + s >= scene_.dx)
+      P.drive_x0[p] = std::numeric_limits<double>::quiet_NaN();
+  if (P.size() != n0) summary_step_ = -1;  // the update's summary did not see the new ice
+}
+
+template <int Dim>
 void Simulation<Dim>::init_gate() {
   // Ice that starts past the gate (a draped glacier) never passes it: it is marked so, and
   // only ice that crosses the gate is recorded and counted in the passed length.
@@ -1295,7 +1347,7 @@ void Simulation<Dim>::save_checkpoint(const std::string& path) const {
     ck::put(o, time_); ck::put(o, dt_); ck::put(o, steps_); ck::put(o, particle_steps_);
     ck::put(o, return_map_evaluations_); ck::put(o, removed_mass_); ck::put(o, front_x_);
     ck::put(o, max_speed_); ck::put(o, static_cast<std::uint8_t>(settled_));
-    ck::put(o, gate_passed_volume_);
+    ck::put(o, gate_passed_volume_); ck::put(o, inflow_mass_); ck::put(o, inflow_columns_);
     const auto& P = particles_;
     ck::put_vector(o, P.x); ck::put_vector(o, P.v); ck::put_vector(o, P.C); ck::put_vector(o, P.F_e);
     ck::put_vector(o, P.tau); ck::put_vector(o, P.mass); ck::put_vector(o, P.vol0);
@@ -1324,11 +1376,12 @@ void Simulation<Dim>::load_checkpoint(const std::string& path) {
   std::int32_t dim = 0;
   ck::get(i, dim);
   if (dim != Dim) throw bad("written for another dimension");
-  double time = 0, dt = 0, removed = 0, front = 0, vmax = 0, gate_volume = 0;
-  std::int64_t steps = 0, psteps = 0, rmaps = 0;
+  double time = 0, dt = 0, removed = 0, front = 0, vmax = 0, gate_volume = 0, inflow_mass = 0;
+  std::int64_t steps = 0, psteps = 0, rmaps = 0, inflow_columns = 0;
   std::uint8_t settled = 0;
   ck::get(i, time); ck::get(i, dt); ck::get(i, steps); ck::get(i, psteps); ck::get(i, rmaps);
   ck::get(i, removed); ck::get(i, front); ck::get(i, vmax); ck::get(i, settled); ck::get(i, gate_volume);
+  ck::get(i, inflow_mass); ck::get(i, inflow_columns);
   Particles<Dim> P;
   constexpr std::uint64_t kMax = std::uint64_t{1} << 34;
   const bool ok = ck::get_vector(i, P.x, kMax) && ck::get_vector(i, P.v, kMax) &&
@@ -1356,6 +1409,7 @@ void Simulation<Dim>::load_checkpoint(const std::string& path) {
   time_ = time; dt_ = dt; steps_ = steps; particle_steps_ = psteps; return_map_evaluations_ = rmaps;
   removed_mass_ = removed; front_x_ = front; max_speed_ = vmax; settled_ = settled != 0;
   settling_ = false; gate_passed_volume_ = gate_volume;
+  inflow_mass_ = inflow_mass; inflow_columns_ = inflow_columns;
 }
 
 template <int Dim>

@@ -59,6 +59,7 @@ class Simulation {
   // Diagnostics (conservation checks, hard-case assertions).
   double total_mass() const;
   double removed_mass() const { return removed_mass_; }
+  double inflow_mass() const { return inflow_mass_; }  // mass that entered through the inflow
   Vec<Dim> total_momentum() const;
   double kinetic_energy() const;
   double gravitational_potential_energy() const;
@@ -167,6 +168,9 @@ class Simulation {
   template <bool Plastic>
   void finish_step();
   void remove_outflow();
+  void inflow();
+  // Columns of ice that have entered through the inflow by the time the drive has moved by s.
+  std::int64_t inflow_columns_due(double s) const;
   void init_gate();
   // gate_eps of a particle not recorded yet, and of one that started past the gate; recorded
   // values are ε_v^p ≥ 0.
@@ -224,6 +228,8 @@ class Simulation {
   std::int64_t particle_steps_ = 0;
   std::int64_t return_map_evaluations_ = 0;
   double removed_mass_ = 0.0;
+  double inflow_mass_ = 0.0;
+  std::int64_t inflow_columns_ = 0;  // columns seeded by the inflow so far
   // Gate records of particles since removed by the outflow: initial position, ε_v^p at the gate.
   std::vector<std::array<float, Dim>> gate_archive_x_;
   std::vector<float> gate_archive_eps_;

@@ -59,7 +59,8 @@ CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx) {
   out.sim_time_s = r.sim_time_s;
   out.result_extra = {
       {"initial_mass_kg", r.initial_mass},    {"final_mass_kg", r.final_mass},
-      {"removed_mass_kg", r.removed_mass},    {"initial_particles", r.initial_particles},
+      {"removed_mass_kg", r.removed_mass},    {"inflow_mass_kg", r.inflow_mass},
+      {"initial_particles", r.initial_particles},
       {"final_particles", r.final_particles}, {"return_map_evaluations", r.return_map_evaluations}};
   out.run_json = {{"engine_wall_s", r.wall_s},
                   {"resumed_from_time_s", r.resumed_from_time_s},

@@ -123,6 +123,7 @@ int run_command(const RunCommandOptions& opt) {
       {"initial_mass", r.initial_mass},
       {"final_mass", r.final_mass},
       {"removed_mass", r.removed_mass},
+      {"inflow_mass", r.inflow_mass},
       {"stage_seconds", r.stage_seconds},
       {"engine_version", CREVASSE_ENGINE_VERSION},
   };
