@@ -90,8 +90,8 @@ struct SceneConfig {
   std::string drive_start = "ramp";
   // What drives the glacier at its back. "piston": the back layer of the slab is pushed at V_x,
   // so the slab behind the step is consumed and the push grows with its length. "inflow": the
-  // back layer stays in place and ice enters through it at V_x, a copy of the ice just inside
-  // (Simulation::inflow), so the upstream ice is only as long as upstream_length.
+  // grid nodes at the back of the domain move at V_x and ice enters there, a copy of the ice
+  // just inside (Simulation::inflow), so the upstream ice is only as long as upstream_length.
   std::string drive_boundary = "piston";
   double gravity = 9.81;              // g [m/s²]
   double gravity_tilt_deg = 0.0;      // tilt of gravity towards +x (incline tests) [deg]

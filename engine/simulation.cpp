@@ -91,9 +91,11 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   add_stage("p2g", [this] { particle_to_grid(); });
   add_stage(g != 0.0 ? "grid_velocity_gravity" : "grid_velocity",
             [this, gravity] { grid_velocity(gravity); });
-  if (scene_.has(Effect::drive)) add_stage("drive_grid", [this] { drive_grid_nodes(); });
+  const bool has_inflow = scene_.drive_boundary == "inflow";
+  if (scene_.has(Effect::drive) && !has_inflow) add_stage("drive_grid", [this] { drive_grid_nodes(); });
   if (scene_.has(Effect::basal_friction))
     add_stage("basal_friction", [this] { apply_bed_friction_to_grid(); });
+  if (has_inflow) add_stage("inflow_grid", [this] { drive_inflow_nodes(); });
   if (scene_.has(Effect::downstream_drive))
     add_stage("downstream_drive", [this] { drive_downstream_nodes(); });
   if (scene_.has(Effect::lateral_walls)) {
@@ -141,14 +143,14 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   }
   // Applied by the update sweep to each particle as it is written (finish_particle).
   tail_effects_.bed = scene_.has(Effect::basal_friction);
-  tail_effects_.drive = scene_.has(Effect::drive);
+  tail_effects_.drive = scene_.has(Effect::drive) && !has_inflow;  // the piston's kinematic layer
   if (tail_effects_.bed) particle_effects_.push_back("bed_projection");
   if (tail_effects_.drive) particle_effects_.push_back("drive");
   // Particles never leave the domain: the last line of defence, whatever the effects.
   particle_effects_.push_back("domain_clamp");
   if (scene_.records_gate()) add_stage("gate", [this] { record_gate(); });
   if (scene_.has(Effect::outflow)) add_stage("outflow", [this] { remove_outflow(); });
-  if (scene_.drive_boundary == "inflow") add_stage("inflow", [this] { inflow(); });
+  if (has_inflow) add_stage("inflow", [this] { inflow(); });
   add_stage("time_step", [this] { update_time_step(); });
 
   update_time_step();
@@ -342,7 +344,7 @@ void Simulation<Dim>::seed_particles() {
   }
   particles_.shrink_to_fit();
   if (scene_.has(Effect::plasticity)) particles_.eps_v_p.assign(particles_.size(), 0.0);
-  if (scene_.has(Effect::drive)) {
+  if (scene_.has(Effect::drive) && scene_.drive_boundary == "piston") {
     particles_.drive_x0.assign(particles_.size(), std::numeric_limits<double>::quiet_NaN());
     for (std::size_t p = 0; p < particles_.size(); ++p)
       if (particles_.x[p][0] < lo[0] + dx) particles_.drive_x0[p] = particles_.x[p][0];
@@ -585,13 +587,28 @@ void Simulation<Dim>::drive_downstream_nodes() {
   // move with it, at (V(t), 0) on the flat floor. Without this the floor ice is free to be
   // pushed away by the ice on the ramp, which at μ_b = 0.1 is not held by friction alone
   // (ρ g H_i (H_s − μ_b L_s) down the ramp against μ_b ρ g H_i L_floor on the floor).
+  hold_nodes_at_drive_speed(domain_hi_[0] - kDownstreamDriveCells * scene_.dx,
+                            std::numeric_limits<double>::infinity(), true);
+}
+
+template <int Dim>
+void Simulation<Dim>::drive_inflow_nodes() {
+  // The inflow: the nodes up to kInflowHoldCells from the back move at V(t) along x, free
+  // vertically. Every particle within 2.5 cells of the back has its whole stencil on them, so it
+  // moves at exactly V(t) and its F_E sees the same velocity field as its position does; the
+  // ice ahead is pushed through the grid, and its compression is stress.
+  hold_nodes_at_drive_speed(-std::numeric_limits<double>::infinity(), kInflowHoldCells * scene_.dx, false);
+}
+
+template <int Dim>
+void Simulation<Dim>::hold_nodes_at_drive_speed(double x_lo, double x_hi, bool hold_vertical) {
   const double v = settling_ ? 0.0 : scene_.drive_velocity(time_);
-  const double x_hold = domain_hi_[0] - kDownstreamDriveCells * scene_.dx;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid_.node_count(), kGrain), [&](const auto& r) {
     for (std::size_t f = r.begin(); f != r.end(); ++f) {
       if (grid_.nodes[f].mass <= 0.0) continue;
-      if (grid_.position(grid_.node_of(f))[0] < x_hold) continue;
-      grid_.nodes[f].vel.setZero();
+      const double x = grid_.position(grid_.node_of(f))[0];
+      if (x < x_lo || x > x_hi) continue;
+      if (hold_vertical) grid_.nodes[f].vel.setZero();
       grid_.nodes[f].vel[0] = v;
     }
   });
@@ -1051,54 +1068,43 @@ void Simulation<Dim>::remove_outflow() {
 }
 
 template <int Dim>
-std::int64_t Simulation<Dim>::inflow_columns_due(double s) const {
-  return static_cast<std::int64_t>(std::floor(s * scene_.particles_per_cell_axis / scene_.dx));
-}
-
-template <int Dim>
 void Simulation<Dim>::inflow() {
-  // The back layer (x < dx at the start, one cell) stays where it is, moved along x at the drive
-  // speed by finish_particle and drive_grid_nodes like the piston. Each time the drive has moved
-  // by one particle spacing h, the band of driven ice h wide just inside the layer is copied h
-  // further back, into the place it has vacated: the same stress, mass and vertical position, so
-  // the ice enters already settled and loaded, with no step in its state. Driven ice that has
-  // passed the layer's downstream face (x ≥ dx) is released to move freely.
+  // The ice within 2.5 cells of the back moves at exactly the drive speed (drive_inflow_nodes).
+  // Each time the drive has moved by one particle spacing h, the band of ice h wide that entered
+  // last, now at x ∈ [h, 2h), is copied h further back, into the place it has left: the same
+  // F_E, stress, mass, velocity and height, so the ice enters settled and loaded, with no step in
+  // its state. Serial, once every h/V_x of simulated time.
   if (settling_) return;
   auto& P = particles_;
   const double h = scene_.dx / scene_.particles_per_cell_axis;
   const double s = scene_.drive_position(time_);
-  const std::int64_t due = inflow_columns_due(s);
-  const std::size_t n0 = P.size();
+  const auto due = static_cast<std::int64_t>(std::floor(s / h));  // columns entered by now
   for (; inflow_columns_ < due; ++inflow_columns_) {
-    // The band of column k = inflow_columns_ + 1 at its crossing (s = k h): x ∈ [h, 2h).
-    const double k = static_cast<double>(inflow_columns_ + 1);
-    const double lo = (1.0 - k) * h, hi = (2.0 - k) * h;
+    // The band's place when the drive had moved k h, plus what it has moved since.
+    const double since = s - static_cast<double>(inflow_columns_ + 1) * h;
+    const double lo = h + since, hi = 2.0 * h + since;
     const std::size_t n = P.size();
     for (std::size_t q = 0; q < n; ++q) {
-      const double d0 = P.drive_x0[q];
-      if (!(d0 >= lo && d0 < hi)) continue;  // NaN (released) fails both
+      if (!(P.x[q][0] >= lo && P.x[q][0] < hi)) continue;
       Vec<Dim> pos = P.x[q];
-      pos[0] = d0 - h + s;
+      pos[0] -= h;
       P.push_back(pos, P.mass[q], P.vol0[q], P.F_e[q], P.tau[q]);
       P.v.back() = P.v[q];
-      P.drive_x0.push_back(d0 - h);
+      P.C.back() = P.C[q];
       if (P.has_plastic_state()) P.eps_v_p.push_back(0.0);
       if (records_gate()) {
         // The gate frame's "initial position": where this ice would have been at t = 0 had the
         // slab reached that far upstream, so the recorded field stays one continuous glacier.
         std::array<float, Dim> ref;
         for (int a = 0; a < Dim; ++a) ref[a] = static_cast<float>(pos[a]);
-        ref[0] = static_cast<float>(d0 - h);
+        ref[0] = static_cast<float>(pos[0] - s);
         P.x_ref.push_back(ref);
         P.gate_eps.push_back(kGateNotYet);
       }
       inflow_mass_ += P.mass[q];
     }
+    summary_step_ = -1;  // the update's summary did not see the new ice
   }
-  for (std::size_t p = 0; p < n0; ++p)
-    if (!std::isnan(P.drive_x0[p]) && P.drive_x0[p] + s >= scene_.dx)
-      P.drive_x0[p] = std::numeric_limits<double>::quiet_NaN();
-  if (P.size() != n0) summary_step_ = -1;  // the update's summary did not see the new ice
 }
 
 template <int Dim>

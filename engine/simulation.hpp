@@ -127,6 +127,14 @@ class Simulation {
   void grid_velocity(const Vec<Dim>& gravity);
   void drive_grid_nodes();
   void drive_downstream_nodes();
+  void drive_inflow_nodes();
+  // Nodes with mass and x in [x_lo, x_hi] move at the drive speed along x (and, when
+  // hold_vertical, not at all vertically).
+  void hold_nodes_at_drive_speed(double x_lo, double x_hi, bool hold_vertical);
+  // The inflow holds the nodes up to this many cells from the back: a quadratic stencil reaches
+  // 1.5 cells, so the ice within 2.5 cells of the back gathers only held nodes, which covers the
+  // band the inflow copies (x < 2h ≤ 2 dx) at any particles per cell.
+  static constexpr double kInflowHoldCells = 3.0;
   void start_moving();  // drive.start "moving": the settled glacier set in motion along its bed
   // downstream_drive holds the nodes of this many cells upstream of the domain's end (the
   // outflow line is 3 cells from it, so 2 cells of ice before it move at the drive speed).
@@ -169,8 +177,6 @@ class Simulation {
   void finish_step();
   void remove_outflow();
   void inflow();
-  // Columns of ice that have entered through the inflow by the time the drive has moved by s.
-  std::int64_t inflow_columns_due(double s) const;
   void init_gate();
   // gate_eps of a particle not recorded yet, and of one that started past the gate; recorded
   // values are ε_v^p ≥ 0.

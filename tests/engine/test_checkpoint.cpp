@@ -40,8 +40,8 @@ void expect_same_state(const ParticleSnapshot& a, const ParticleSnapshot& b) {
   EXPECT_EQ(a.gate_passed_length_m, b.gate_passed_length_m);
 }
 
-TEST(Checkpoint, RestoredSimulationContinuesBitForBit) {
-  const SceneConfig scene = scene_from_json(test::shipped_scene_json());
+void expect_restored_run_continues_bit_for_bit(const std::string& scene_file) {
+  const SceneConfig scene = scene_from_json(test::shipped_scene_json(scene_file));
   const fs::path file = scratch("sim");
   Simulation<2> a(scene);
   // 2,050 steps: past a particle re-sort (every 100 steps) on both sides of the checkpoint, and
@@ -56,8 +56,17 @@ TEST(Checkpoint, RestoredSimulationContinuesBitForBit) {
   while (b.steps() < 4050) b.step();
   expect_same_state(a.snapshot(), b.snapshot());
   EXPECT_EQ(a.removed_mass(), b.removed_mass());
+  EXPECT_EQ(a.inflow_mass(), b.inflow_mass());
   EXPECT_EQ(a.gate_passed_length(), b.gate_passed_length());
   fs::remove(file);
+}
+
+TEST(Checkpoint, RestoredSimulationContinuesBitForBit) { expect_restored_run_continues_bit_for_bit("glacier_2d.json"); }
+
+// The inflow's state (columns entered, mass entered) is in the checkpoint: the restored run seeds
+// the same columns at the same steps (each 1.25 s here, so six before and seven after the save).
+TEST(Checkpoint, RestoredInflowContinuesBitForBit) {
+  expect_restored_run_continues_bit_for_bit("flowing_inflow_2d.json");
 }
 
 TEST(Checkpoint, OtherSceneAndTruncatedFilesAreRefused) {

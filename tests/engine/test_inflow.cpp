@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <vector>
 
 #include "engine/error.hpp"
 #include "engine/simulation.hpp"
@@ -76,40 +78,75 @@ TEST(Inflow, TheUpstreamIceIsNeitherConsumedNorTorn) {
   for (int b = 1; b < checked; ++b) EXPECT_NEAR(count[b], full, 2) << "band at x = " << b * h << " m";
 }
 
-// DISABLED, known defect: the acceptance test of an inflow that holds V_x in thick ice. Measured
-// (mass-weighted mean v_x of the ice 2–4 dx ahead of the driven layer): at H_i = 100 m it moves
-// at 0.98 V_x from 10 s to 100 s, and the whole plateau with it; at H_i = 800 m at 0.82–0.84 V_x
-// at 10, 50 and 100 s (1.0 V_x at 25 s), where the piston of the same scene holds 0.98–0.99 V_x.
-// The entering ice then crowds behind the released ice (docs/model.md, "Inflow").
-TEST(Inflow, DISABLED_HoldsTheDriveSpeedInThickIce) {
+// Mass-weighted mean x of the ice that started with x in [x0, x1) (its gate-frame reference).
+double mean_x_of_ice_started_in(const Simulation<2>& sim, double x0, double x1) {
+  const auto& P = sim.particles();
+  double mx = 0.0, m = 0.0;
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    if (P.x_ref[p][0] < x0 || P.x_ref[p][0] >= x1) continue;
+    mx += P.mass[p] * P.x[p][0];
+    m += P.mass[p];
+  }
+  return mx / m;
+}
+
+// The inflow feeds the plateau at V_x in thick ice, where the piston leaks (test_piston.cpp,
+// DISABLED_StaysBehindTheIceAtEightHundredMetres): at H_i = 800 m the ice that started in the
+// middle of the plateau advances at V_x within 1 % from 50 s to 100 s. Measured: 4.003 m/s;
+// the piston of the same scene gives 3.95 m/s, and an inflow whose back layer was moved
+// kinematically ahead of the grid's velocity gave 3.65 m/s (the entering ice crowded behind the
+// ice it had been released into, without compressing it).
+TEST(Inflow, HoldsTheDriveSpeedInThickIce) {
   const SceneConfig scene = inflow_scene(800.0, 2.0);
   Simulation<2> sim(scene);
   sim.settle();
+  while (sim.time() < 50.0) sim.step();
+  const double h = scene.ice_thickness;
+  const double t0 = sim.time(), x0 = mean_x_of_ice_started_in(sim, 0.5 * h, h);
   while (sim.time() < 100.0) sim.step();
-  const auto& P = sim.particles();
-  double momentum = 0.0, mass = 0.0;
-  for (std::size_t p = 0; p < P.size(); ++p) {
-    if (P.x[p][0] < 2.0 * scene.dx || P.x[p][0] > 4.0 * scene.dx) continue;
-    momentum += P.mass[p] * P.v[p][0];
-    mass += P.mass[p];
-  }
-  ASSERT_GT(mass, 0.0);
-  EXPECT_NEAR(momentum / mass, scene.drive_speed, 0.05 * scene.drive_speed);
+  const double speed = (mean_x_of_ice_started_in(sim, 0.5 * h, h) - x0) / (sim.time() - t0);
+  EXPECT_NEAR(speed, scene.drive_speed, 0.01 * scene.drive_speed);
 }
 
-// The gate frame places entering ice where it would have started had the slab reached that far
-// upstream: the recorded field is one glacier, its reference positions continuing below x = 0.
-TEST(Inflow, EnteringIceContinuesTheGateFrameUpstream) {
+// The entering ice is the loaded glacier continued upstream: in the gate frame its reference
+// positions fill every band h wide below x = 0 with one full column (no gap, no overlap), and
+// while it is still in the held layer (x < 2.5 dx, where it moves at exactly V_x), away from the
+// surface and the bed (depths 0.2–0.8 H_i), its vertical stress is the cryostatic
+// σ_zz = −ρ_i g (s − z) of the start within 5 % of ρ_i g H_i. Ice entering unstressed, or a copy
+// of the wrong band, would be off by tens of %. Past the layer the ice takes the plateau's own
+// stress (the push against basal friction, the basal mode of docs/model.md), not checked here.
+TEST(Inflow, EnteringIceContinuesTheGlacierUpstream) {
   const SceneConfig scene = inflow_scene(100.0, 2.0);
   Simulation<2> sim(scene);
   sim.settle();
-  while (sim.time() < 10.0) sim.step();
+  while (sim.time() < 30.0) sim.step();
+  const auto& P = sim.particles();
   const double h = scene.dx / scene.particles_per_cell_axis;
-  double lowest = std::numeric_limits<double>::infinity();
-  for (std::size_t p = 0; p < sim.particles().size(); ++p)
-    lowest = std::min(lowest, static_cast<double>(sim.particles().x_ref[p][0]));
-  // After 10 s the drive has moved 40 m: the entering ice spans [−40, 0] m of reference x.
-  EXPECT_NEAR(lowest, 0.5 * h - std::floor(scene.drive_speed * sim.time() / h) * h, 1e-3);
+  const int entered = static_cast<int>(std::floor(scene.drive_speed * sim.time() / h));
+  ASSERT_GE(entered, 20);
+  std::vector<int> count(entered, 0);
+  const double rho_g = scene.density * scene.gravity;
+  const double top = scene.step_height + scene.ice_thickness;
+  double worst = 0.0;
+  int stressed = 0;
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    const double ref = P.x_ref[p][0];
+    if (ref >= 0.0) continue;
+    const int b = static_cast<int>(std::floor(-ref / h));
+    ASSERT_LT(b, entered) << ref;
+    ++count[b];
+    const double depth = top - P.x[p][1];
+    if (depth < 0.2 * scene.ice_thickness || depth > 0.8 * scene.ice_thickness) continue;
+    if (P.x[p][0] >= 2.5 * scene.dx) continue;
+    const double sigma_zz = P.tau[p](1, 1) / P.F_e[p].determinant();
+    worst = std::max(worst, std::abs(sigma_zz + rho_g * depth) / (rho_g * scene.ice_thickness));
+    ++stressed;
+  }
+  const int full = static_cast<int>(std::round(scene.ice_thickness / h));
+  for (int b = 0; b < entered; ++b) EXPECT_EQ(count[b], full) << "band " << b;
+  EXPECT_GT(stressed, 50);
+  std::cout << "entering ice: sigma_zz within " << worst << " rho_i g H_i of the cryostatic state\n";
+  EXPECT_LT(worst, 0.05);
 }
 
 TEST(Inflow, IsRefusedWithoutTheDriveOrABoundaryItKnows) {
