@@ -149,4 +149,13 @@ ParticleSnapshot gate_frame_snapshot(const ParticleSnapshot& snapshot);
 // on "gate" without gate records).
 bool uses_gate_frame(const ParticleSnapshot& snapshot, const MeasureSettings& settings);
 
+// The strength regime's length c/(ρ_i g) spans fewer than 3 cells (the resolution floor): a case
+// there cannot show strength-spaced crevasses, so it is flagged and left out of fits by default
+// (docs/measurement.md, "Resolution rule").
+inline constexpr double kStrengthLengthMinCells = 3.0;
+inline bool strength_under_resolved(double tensile_strength_pa, double density, double gravity,
+                                    double dx_m) {
+  return tensile_strength_pa / (density * gravity) < kStrengthLengthMinCells * dx_m;
+}
+
 }  // namespace crevasse::analysis

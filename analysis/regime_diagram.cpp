@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <stdexcept>
 
 namespace crevasse::analysis {
@@ -207,13 +208,20 @@ Figure regime_diagram(const std::vector<RegimePoint>& points, const RegimeFit& f
     annotations = add_broken_line(figure, *broken, options);
   }
 
+  std::vector<std::string> hollow_reasons;
   for (std::size_t g = 0; g < groups.size(); ++g) {
     std::vector<double> x, y, x_bar, lo, hi;
+    std::map<std::string, std::pair<std::vector<double>, std::vector<double>>> hollow;
     for (const RegimePoint& p : points) {
       if (p.group != groups[g]) continue;
       if (p.failed) continue;
-      x.push_back(p.pi);
-      y.push_back(p.y);
+      if (p.hollow) {
+        hollow[p.hollow_reason].first.push_back(p.pi);
+        hollow[p.hollow_reason].second.push_back(p.y);
+      } else {
+        x.push_back(p.pi);
+        y.push_back(p.y);
+      }
       if (std::isfinite(p.y_q25) && std::isfinite(p.y_q75)) {
         x_bar.push_back(p.pi);
         lo.push_back(p.y_q25);
@@ -222,8 +230,16 @@ Figure regime_diagram(const std::vector<RegimePoint>& points, const RegimeFit& f
     }
     const Color color = palette_color(g);
     figure.add_error_bars(x_bar, lo, hi, color.with_alpha(0.8));
-    figure.add_points(x, y, {palette_marker(g), color, 6.5, true},
-                      groups[g].empty() ? "cases" : groups[g]);
+    if (!x.empty() || hollow.empty())
+      figure.add_points(x, y, {palette_marker(g), color, 6.5, true},
+                        groups[g].empty() ? "cases" : groups[g]);
+    for (const auto& [reason, xy] : hollow) {
+      const bool named =
+          std::find(hollow_reasons.begin(), hollow_reasons.end(), reason) != hollow_reasons.end();
+      if (!named) hollow_reasons.push_back(reason);
+      figure.add_points(xy.first, xy.second, {palette_marker(g), color, 6.5, false},
+                        named ? "" : reason);
+    }
   }
   constexpr MarkerShape kMissingShapes[] = {MarkerShape::cross, MarkerShape::plus,
                                             MarkerShape::circle, MarkerShape::square,
@@ -243,7 +259,8 @@ Figure regime_diagram(const std::vector<RegimePoint>& points, const RegimeFit& f
     }
   }
   add_annotations(figure, annotations, layout.legend);
-  keep_points_clear_of_legend(figure, points, groups.size() + reasons.size() + fit_entries,
+  keep_points_clear_of_legend(figure, points,
+                              groups.size() + reasons.size() + hollow_reasons.size() + fit_entries,
                               layout);
   return figure;
 }

@@ -23,6 +23,10 @@ struct RegimePoint {
   // Why a failed point has no value. Each distinct reason gets its own bottom-edge marker
   // (cross, plus, then hollow shapes) and legend entry, e.g. "failed" and "no crevasse".
   std::string missing_reason = "failed / no crevasse";
+  // A value drawn hollow and left out of the legend's group entry, e.g. an under-resolved case
+  // that was not fitted; the legend names it once.
+  bool hollow = false;
+  std::string hollow_reason = "under-resolved, not fitted";
 };
 
 // No fit, one power law, or a broken line.

@@ -64,7 +64,7 @@ for name in "${studies[@]}"; do
       ;;
     three_d)
       # The 3D cases on the diagram of the 2D study at the same groups (quick).
-      $crevasse plot results/quick.db --out "results/${name}_figures" --add-cases "$db"
+      $crevasse plot results/cliff_quick.db --out "results/${name}_figures" --add-cases "$db"
       ;;
     three_d_long)
       # The long-window 3D cases on the diagram of their 2D counterpart (run two_d_long first).

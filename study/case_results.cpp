@@ -64,8 +64,9 @@ std::vector<CaseRecord> read_case_records(Store& store) {
               "m.case_id IS NOT NULL, m.crevasse_count, m.spacing_count, m.no_crevasse, "
               "m.fragmented, m.spacing_q25_over_h, m.spacing_median_over_h, "
               "m.spacing_q75_over_h, m.depth_q25_over_h, m.depth_median_over_h, "
-              "m.depth_q75_over_h, m.spacings_json "
-              "FROM cases c LEFT JOIN summaries m USING (case_id) ORDER BY c.case_index, "
+              "m.depth_q75_over_h, m.spacings_json, " +
+              std::string(store.schema_version() >= 2 ? "c.under_resolved" : kUnderResolvedSql) +
+              " FROM cases c LEFT JOIN summaries m USING (case_id) ORDER BY c.case_index, "
               "c.replica, c.case_id");
   std::vector<CaseRecord> out;
   while (s.step()) {
@@ -90,6 +91,8 @@ std::vector<CaseRecord> read_case_records(Store& store) {
         for (const auto& v : j)
           if (v.is_number()) r.spacings_m.push_back(v.get<double>());
     }
+    ++k;
+    r.under_resolved = s.integer(k++) != 0;
     out.push_back(std::move(r));
   }
   if (out.empty()) throw InputError(where + ": the study has no cases");

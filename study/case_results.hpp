@@ -54,6 +54,7 @@ struct CaseRecord {
   std::int64_t spacing_count = 0;
   bool no_crevasse = false;
   bool fragmented = false;
+  bool under_resolved = false;  // c/(ρ_i g) < 3 dx: the strength regime cannot show
   // q25, median, q75 of L_p/H_i and of D_p/H_i (empty when nothing was measured).
   std::array<std::optional<double>, 3> spacing_over_h, depth_over_h;
   std::vector<double> spacings_m;  // every spacing kept [m]

@@ -2,11 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <stdexcept>
 
 #include "analysis/measurement_io.hpp"
 #include "engine/error.hpp"
 #include "engine/run.hpp"
+#include "study/case_views.hpp"
 
 namespace crevasse {
 namespace {
@@ -71,6 +74,12 @@ CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx) {
     out.measurement = analysis::measure_crevasses(r.final_snapshot, ctx.measurement());
   } catch (const std::invalid_argument& e) {
     throw SimulationError(std::string("measurement of the final snapshot failed: ") + e.what());
+  }
+  if (!ctx.views_dir().empty()) {
+    std::filesystem::create_directories(ctx.views_dir());
+    char stem[32];
+    std::snprintf(stem, sizeof stem, "case_%03zu_", study_case.index);
+    write_case_views(study_case.scene, r.final_snapshot, *out.measurement, ctx.views_dir(), stem);
   }
   return out;
 }

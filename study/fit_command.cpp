@@ -100,6 +100,8 @@ int fit_command(const FitCommandOptions& opt) {
   StudyFitOptions spacing_options, depth_options;
   spacing_options.level = depth_options.level = opt.level;
   spacing_options.exclude_fragmented = depth_options.exclude_fragmented = opt.exclude_fragmented;
+  spacing_options.include_under_resolved = depth_options.include_under_resolved =
+      opt.include_under_resolved;
   if (!opt.fixed_exponents.empty())
     parse_fixed_exponents(opt.fixed_exponents, "--fixed-exponents", spacing_options);
   if (!opt.fixed_depth_exponents.empty())

@@ -14,6 +14,7 @@ struct FitCommandOptions {
   std::string fixed_depth_exponents;  // the same for D_p/H_i
   double level = 0.95;
   bool exclude_fragmented = false;
+  bool include_under_resolved = false;  // fit cases with c/(ρ_i g) < 3 dx too
   bool no_store = false;  // print only
 };
 

@@ -81,6 +81,7 @@ int main(int argc, char** argv) {
   study->add_flag("--retry-failed", study_opt.retry_failed, "Run cases stored as failed again");
   study->add_flag("--dry-run", study_opt.dry_run, "List the cases and their hashes; run nothing");
   study->add_flag("--quiet", study_opt.quiet, "No progress output");
+  study->add_option("--views", study_opt.views_dir, "Folder for the side views of each case run (case_NNN_side_view.png, case_NNN_gate_view.png; NNN as in --dry-run)");
 
   crevasse::StatusCommandOptions status_opt;
   auto* status = app.add_subcommand("status", "Summarise a study database (safe while the study runs)");
@@ -106,6 +107,7 @@ int main(int argc, char** argv) {
   fit->add_option("--fixed-depth-exponents", fit_opt.fixed_depth_exponents, "The same for D_p/H_i");
   fit->add_option("--level", fit_opt.level, "Confidence level of the intervals (default 0.95)");
   fit->add_flag("--exclude-fragmented", fit_opt.exclude_fragmented, "Leave out cases flagged fragmented");
+  fit->add_flag("--include-under-resolved", fit_opt.include_under_resolved, "Fit cases flagged under_resolved (c/(rho_i g) < 3 dx) too; by default they are left out");
   fit->add_flag("--no-store", fit_opt.no_store, "Print the table only; do not write the fits table");
 
   crevasse::PlotCommandOptions plot_opt;
@@ -120,6 +122,7 @@ int main(int argc, char** argv) {
   plot->add_option("--cdf-cases", plot_opt.cdf_cases, "Case indexes for the spacing CDFs (default: up to 4 spread over the group)")->delimiter(',');
   plot->add_option("--cdf-normalise", plot_opt.cdf_normalise, "Spacing CDFs normalised by: median (of each case), thickness, none");
   plot->add_option("--add-cases", plot_opt.add_cases, "Other study databases whose cases are drawn too, not fitted (e.g. 3D cases on the 2D diagram)")->delimiter(',');
+  plot->add_flag("--include-under-resolved", plot_opt.include_under_resolved, "Fit and draw under_resolved cases (c/(rho_i g) < 3 dx) like the others; by default they are drawn hollow and not fitted");
   plot->add_flag("--exclude-fragmented", plot_opt.exclude_fragmented, "Leave fragmented cases out of the drawn fit, marked on the bottom edge (default: as the fits table was made)");
 
   crevasse::CalibrateCommandOptions calibrate_opt;

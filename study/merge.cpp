@@ -55,7 +55,10 @@ MergeReport merge_databases(const fs::path& out, const std::vector<fs::path>& in
     if (fs::exists(out) && fs::equivalent(in, out, ec))
       throw InputError("merge: input " + in.string() +
                        " is the output database; give a new OUT path");
-    Store::open_reader(in);  // exists and is a study database of this schema
+    // Exists and is a study database of this schema (the tables are copied column by column).
+    if (Store::open_reader(in).schema_version() != kStoreSchemaVersion)
+      throw InputError("merge: " + in.string() + " was written by an older crevasse (schema " +
+                       "version 1); resume its study once with this crevasse to upgrade it");
   }
   MergeReport report;
   Store store = Store::open_writer(out);

@@ -152,6 +152,7 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
                     option);
     // Leave fragmented cases out of the fit when asked, or when the stored fits did.
     fit_opts.exclude_fragmented = opt.exclude_fragmented;
+    fit_opts.include_under_resolved = opt.include_under_resolved;
     for (const FitRecord& r : read_fit_records(store, quantity_key(q), group.name))
       if (r.accounting.find(kFragmentedExcluded) != std::string::npos)
         fit_opts.exclude_fragmented = true;
@@ -175,6 +176,8 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
         ++missing[p.missing_reason];
       } else if (const auto y = c.median(q)) {
         p.y = *y;
+        p.hollow = c.under_resolved && !fit_opts.include_under_resolved;
+        p.hollow_reason = "under-resolved: c/(ρ_i g) < 3 dx, not fitted";
         const auto& quartiles = c.quartiles(q);
         if (quartiles[0] && quartiles[2] && *quartiles[0] > 0.0) {
           p.y_q25 = *quartiles[0];

@@ -10,10 +10,10 @@
 #include "analysis/bed_contact.hpp"
 #include "analysis/crevasse_measure.hpp"
 #include "analysis/measurement_io.hpp"
-#include "analysis/side_view.hpp"
 #include "engine/error.hpp"
 #include "engine/run.hpp"
 #include "engine/vtu_writer.hpp"
+#include "study/case_views.hpp"
 #include "study/progress_printer.hpp"
 #include "study/scene_file.hpp"
 
@@ -129,33 +129,14 @@ int run_command(const RunCommandOptions& opt) {
   };
   std::ofstream(out / "run_summary.json") << summary.dump(2) << "\n";
 
-  // Crevasses at the end of the run (docs/measurement.md; in the gate frame when the scene records one,
+  // Crevasses at the end of the run (in the gate frame when the scene records one;
   // docs/measurement.md), and the side views with each one marked.
   const analysis::CrevasseMeasurement m =
       analysis::measure_crevasses(r.final_snapshot, analysis::MeasureSettings{});
   obs.add_row(r.final_snapshot, m);
   analysis::write_crevasses_csv(m, out / "crevasses.csv");
   analysis::write_measurement_summary(m, out / "measurement.json");
-  if (scene.png && r.final_snapshot.size() > 0) {
-    analysis::SideViewOptions view;
-    char extra[128];
-    const double pi_group =
-        scene.tensile_strength / (scene.density * scene.gravity * scene.ice_thickness);
-    std::snprintf(extra, sizeof extra, "c = %.3g MPa   Pi = %.3g", scene.tensile_strength / 1e6,
-                  pi_group);
-    view.title_extra = extra;
-    if (m.settings.frame == "gate") {
-      // The crevasses were measured in the gate frame: the final state is drawn unmarked, and
-      // the recorded pattern at the particles' initial positions gets the marks.
-      analysis::write_side_view_png(r.final_snapshot, (out / "side_view.png").string(), view);
-      analysis::SideViewOptions gate_view = view;
-      gate_view.title_extra += "   damage at the top of the step, at initial positions";
-      analysis::write_side_view_png(analysis::gate_frame_snapshot(r.final_snapshot),
-                                    (out / "gate_view.png").string(), gate_view, &m);
-    } else {
-      analysis::write_side_view_png(r.final_snapshot, (out / "side_view.png").string(), view, &m);
-    }
-  }
+  if (scene.png) write_case_views(scene, r.final_snapshot, m, out);
   if (!opt.quiet) {
     std::fprintf(
         stderr,

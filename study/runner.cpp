@@ -210,6 +210,7 @@ RunnerReport run_study(const Study& study, const RunnerOptions& opt) {
       queue.push(std::move(started));
       if (exact_peak_rss) reset_peak_rss();
       CaseContext ctx(threads, time_limit, study.measurement, stop, fraction[slot]);
+      if (!opt.views_dir.empty()) ctx.set_views_dir(opt.views_dir);
       std::filesystem::path checkpoint;
       if (study.resources.checkpoint_interval_s > 0) {
         // Next to the database: DB.checkpoints/CASE.ckpt (kept only while the case is unfinished).

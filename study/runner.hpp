@@ -57,6 +57,9 @@ class CaseContext {
   }
   const std::filesystem::path& checkpoint_file() const { return checkpoint_file_; }
   double checkpoint_interval_s() const { return checkpoint_interval_s_; }
+  // Where the case writes its side views (empty: none).
+  void set_views_dir(std::filesystem::path dir) { views_dir_ = std::move(dir); }
+  const std::filesystem::path& views_dir() const { return views_dir_; }
 
  private:
   int threads_;
@@ -67,6 +70,7 @@ class CaseContext {
   std::chrono::steady_clock::time_point start_;
   std::filesystem::path checkpoint_file_;
   double checkpoint_interval_s_ = 0.0;
+  std::filesystem::path views_dir_;
 };
 
 // Runs one case; throws (SimulationError, InputError, anything) to fail it.
@@ -112,6 +116,7 @@ struct RunnerOptions {
   std::string command;         // recorded in the sessions table
   CaseFunction case_function;  // empty: run_engine_case (engine_case.hpp)
   StudyObserver* observer = nullptr;
+  std::filesystem::path views_dir;  // non-empty: each case writes its side views there
 };
 
 // Throws InputError before anything runs when the database is unusable or holds another study.

@@ -98,17 +98,20 @@ int status_command(const StatusCommandOptions& opt) {
         "c.step_length_ratio, "
         "c.slope, m.crevasse_count, m.spacing_median_over_h, m.depth_median_over_h, c.wall_s, "
         "c.label, "
-        "m.fragmented FROM cases c LEFT JOIN summaries m USING (case_id) WHERE c.status = 'done' "
-        "ORDER BY c.case_index LIMIT ?");
+        "m.fragmented, " +
+            std::string(store.schema_version() >= 2 ? "c.under_resolved" : kUnderResolvedSql) +
+            " FROM cases c LEFT JOIN summaries m USING (case_id) WHERE c.status = 'done' "
+            "ORDER BY c.case_index LIMIT ?");
     s.bind(1, static_cast<std::int64_t>(limit));
     while (s.step()) {
-      std::printf("  %5lld  %-10s %8s %8s %8s %7s  %5lld %9s %9s %8s  %s%s\n",
+      std::printf("  %5lld  %-10s %8s %8s %8s %7s  %5lld %9s %9s %8s  %s%s%s\n",
                   static_cast<long long>(s.integer(0)), s.text(1).c_str(),
                   cell(s, 2, "%.0f").c_str(), cell(s, 3, "%.4g").c_str(),
                   cell(s, 4, "%.3g").c_str(), cell(s, 5, "%.3g").c_str(),
                   static_cast<long long>(s.integer(6)), cell(s, 7, "%.3f").c_str(),
                   cell(s, 8, "%.3f").c_str(), wall(s.real(9)).c_str(), s.text(10).c_str(),
-                  s.integer(11) ? "  (fragmented)" : "");
+                  s.integer(11) ? "  (fragmented)" : "",
+                  s.integer(12) ? "  (under-resolved: c/(rho_i g) < 3 dx)" : "");
     }
     if (limit >= 0 && c.done > limit)
       std::printf("  ... %lld more (crevasse status --all, or crevasse export --csv)\n",

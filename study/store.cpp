@@ -84,7 +84,8 @@ CREATE TABLE IF NOT EXISTS cases (
   sim_time_s REAL,
   run_json TEXT,
   result_json TEXT,
-  result_hash TEXT
+  result_hash TEXT,
+  under_resolved INTEGER NOT NULL DEFAULT 0
 );
 CREATE INDEX IF NOT EXISTS cases_by_status ON cases(status);
 CREATE TABLE IF NOT EXISTS crevasses (
@@ -241,7 +242,7 @@ void Store::exec(const std::string& sql) {
 
 namespace {
 
-int schema_version(sqlite3* db) {
+int read_user_version(sqlite3* db) {
   Statement s(db, "PRAGMA user_version");
   return s.step() ? static_cast<int>(s.integer(0)) : 0;
 }
@@ -282,7 +283,7 @@ Store Store::open_writer(const fs::path& path) {
   Store store(db, path, fd);
   sqlite3_busy_timeout(db, 10000);
   try {
-    const int version = schema_version(db);
+    const int version = read_user_version(db);
     if (version == 0 && table_count(db) > 0)
       throw InputError(where +
                        ": this file is an SQLite database but not a crevasse study database");
@@ -300,6 +301,10 @@ Store Store::open_writer(const fs::path& path) {
     store.exec("PRAGMA synchronous = FULL");
     store.exec("PRAGMA foreign_keys = ON");
     store.transaction([&] {
+      if (version == 1) {
+        store.exec("ALTER TABLE cases ADD COLUMN under_resolved INTEGER NOT NULL DEFAULT 0");
+        store.exec(std::string("UPDATE cases SET under_resolved = ") + kUnderResolvedSql);
+      }
       store.exec(kSchema);
       store.exec("PRAGMA user_version = " + std::to_string(kStoreSchemaVersion));
     });
@@ -323,16 +328,18 @@ Store Store::open_reader(const fs::path& path) {
   sqlite3_busy_timeout(db, 10000);
   int version = 0;
   try {
-    version = schema_version(db);
+    version = read_user_version(db);
   } catch (const std::runtime_error& e) {
     throw InputError(where + ": not a readable SQLite database (" + e.what() + ")");
   }
-  if (version != kStoreSchemaVersion)
-    throw InputError(where + ": not a crevasse study database of schema version " +
+  if (version < 1 || version > kStoreSchemaVersion)
+    throw InputError(where + ": not a crevasse study database of schema version 1 to " +
                      std::to_string(kStoreSchemaVersion) + " (found " + std::to_string(version) +
                      ")");
   return store;
 }
+
+int Store::schema_version() const { return read_user_version(db_); }
 
 std::optional<std::string> Store::study_hash() {
   Statement s(db_, "SELECT study_hash FROM study WHERE id = 1");
@@ -405,8 +412,8 @@ void Store::add_cases(const std::vector<const StudyCase*>& cases) {
         "cohesion_ratio, step_length_ratio, step_height_ratio, slope, width_ratio, "
         "tensile_strength_pa, "
         "step_length_m, step_height_m, width_m, dx_m, dim, seed, axes_json, scene_json, "
-        "engine_version) "
-        "VALUES (?, ?, ?, ?, 'pending', ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+        "engine_version, under_resolved) "
+        "VALUES (?, ?, ?, ?, 'pending', ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
     for (const StudyCase* c : cases) {
       const SceneConfig& sc = c->scene;
       s.bind(1, c->case_id)
@@ -425,6 +432,10 @@ void Store::add_cases(const std::vector<const StudyCase*>& cases) {
       s.bind(18, c->axes.dump())
           .bind(19, c->scene_json.dump())
           .bind(20, std::string(CREVASSE_ENGINE_VERSION));
+      s.bind(21, analysis::strength_under_resolved(sc.tensile_strength, sc.density, sc.gravity,
+                                                   sc.dx)
+                     ? 1
+                     : 0);
       s.run();
     }
   });

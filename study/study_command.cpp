@@ -46,8 +46,12 @@ class ConsoleObserver : public StudyObserver {
             stats, sizeof stats, "%zu crevasse(s), median spacing %s H_i, median depth %s H_i",
             m.crevasses.size(), m.spacing_over_h ? fmt(m.spacing_over_h->median).c_str() : "-",
             m.depth_over_h ? fmt(m.depth_over_h->median).c_str() : "-");
-      std::fprintf(stderr, "[%zu/%zu] done   %s: %s%s (%s)\n", finished, p.total, c.label.c_str(),
-                   stats, m.flags.fragmented ? ", fragmented" : "", case_wall(r.wall_s).c_str());
+      const SceneConfig& sc = c.scene;
+      const bool under =
+          analysis::strength_under_resolved(sc.tensile_strength, sc.density, sc.gravity, sc.dx);
+      std::fprintf(stderr, "[%zu/%zu] done   %s: %s%s%s (%s)\n", finished, p.total,
+                   c.label.c_str(), stats, m.flags.fragmented ? ", fragmented" : "",
+                   under ? ", under-resolved" : "", case_wall(r.wall_s).c_str());
     } else if (r.status == "done") {
       std::fprintf(stderr, "[%zu/%zu] done   %s (%s)\n", finished, p.total, c.label.c_str(),
                    case_wall(r.wall_s).c_str());
@@ -135,6 +139,7 @@ int study_command(const StudyCommandOptions& opt) {
   ro.retry_failed = opt.retry_failed;
   ro.shard = shard;
   ro.command = opt.command_line;
+  ro.views_dir = opt.views_dir;
   ro.observer = opt.quiet ? nullptr : &console;
   const RunnerReport r = run_study(study, ro);
   const std::size_t failed = r.failed + r.already_failed;

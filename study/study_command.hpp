@@ -16,6 +16,7 @@ struct StudyCommandOptions {
   bool retry_failed = false;
   bool dry_run = false;  // list the cases and their hashes; run nothing, create nothing
   bool quiet = false;
+  std::string views_dir;  // non-empty: side views of every case run, case_NNN_side_view.png
   std::string command_line;  // recorded in the sessions table
 };
 

@@ -67,6 +67,8 @@ StudyFit fit_study(const std::vector<CaseRecord>& cases, Quantity quantity, cons
     std::string reason = c.missing_reason(quantity);
     if (reason.empty() && (!x || !std::isfinite(*x) || *x <= 0.0))
       reason = std::string("without a positive ") + group.name;
+    if (reason.empty() && !options.include_under_resolved && c.under_resolved)
+      reason = kUnderResolvedExcluded;
     if (reason.empty() && options.exclude_fragmented && c.fragmented)
       reason = kFragmentedExcluded;
     if (!reason.empty()) {

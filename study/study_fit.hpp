@@ -21,12 +21,15 @@ std::string short_number(double v);
 // The reason a fit gives for a fragmented case it left out; it is in the fits table's
 // `accounting`, which is how `crevasse plot` knows the stored fits left such cases out.
 inline constexpr const char* kFragmentedExcluded = "fragmented (excluded)";
+inline constexpr const char* kUnderResolvedExcluded = "under-resolved (excluded)";
 
 struct StudyFitOptions {
   double level = 0.95;
   // Exponents of the broken line's segments held at a value (below, above Π*); empty = free.
   std::optional<double> fixed_b1, fixed_b2;
   bool exclude_fragmented = false;  // leave out cases flagged fragmented (kFragmentedExcluded)
+  // Fit cases flagged under_resolved too (by default they are left out: kUnderResolvedExcluded).
+  bool include_under_resolved = false;
 };
 
 struct StudyFit {

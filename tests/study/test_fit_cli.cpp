@@ -35,6 +35,8 @@ void write_synthetic_db(const std::filesystem::path& db, int n_pi,
   nlohmann::json j = test::tiny_study(n_pi, 100, "synthetic");
   j["sweep"]["thickness"] = thicknesses;
   if (n_pi == 1) j["sweep"]["cohesion_ratio"] = {0.2};
+  // Fine enough that every case resolves c/(ρ_i g) (≥ 3 dx down to Π = 0.05 at H_i = 100 m).
+  j["base_scene"]["numerics"]["dx"] = 1.0;
   if (edit) edit(j);
   const Study study = test::parse(j);
   Store store = Store::open_writer(db);
@@ -175,6 +177,50 @@ TEST(FitCli, RecoversKnownLawsAndStoresTheFitsTable) {
   EXPECT_NE(test::read_file(dir / "csv" / "fits.csv").find("spacing_over_h,cohesion_ratio,single"),
             std::string::npos);
   EXPECT_EQ(test::pragma_integrity(dir / "s.db"), "ok");
+}
+
+TEST(FitCli, UnderResolvedCasesAreStoredFlaggedAndLeftOutOfFitsByDefault) {
+  test::ScratchDir dir("fit");
+  // dx = 10 m at H_i = 100 m: c/(ρ_i g) = Π·100 m < 3 dx below Π = 0.3, i.e. 5 of the 8 values
+  // 0.05 … 1 (0.277 is the last one under).
+  write_synthetic_db(dir / "s.db", 8, {100.0}, known_laws(0.05),
+                     [](nlohmann::json& j) { j["base_scene"]["numerics"]["dx"] = 10.0; });
+  EXPECT_EQ(test::dump_rows(dir / "s.db", "SELECT group_concat(under_resolved, '') FROM "
+                                          "(SELECT under_resolved FROM cases ORDER BY case_index)")
+                .at(0),
+            "11111000");
+  const test::CliResult fit = test::run_cli(dir.path(), "fit s.db");
+  ASSERT_EQ(fit.code, 0) << fit.err;
+  EXPECT_NE(fit.out.find("3 of 8 cases fitted; not fitted: 5 under-resolved (excluded)"),
+            std::string::npos)
+      << fit.out;
+  const test::CliResult all = test::run_cli(dir.path(), "fit s.db --include-under-resolved");
+  ASSERT_EQ(all.code, 0) << all.err;
+  EXPECT_NE(all.out.find("8 of 8 cases fitted"), std::string::npos) << all.out;
+  const test::CliResult status = test::run_cli(dir.path(), "status s.db");
+  EXPECT_NE(status.out.find("under-resolved"), std::string::npos) << status.out;
+  const test::CliResult plot = test::run_cli(dir.path(), "plot s.db --out figs");
+  ASSERT_EQ(plot.code, 0) << plot.err;
+  EXPECT_NE(test::read_file(dir / "figs" / "spacing_vs_cohesion_ratio.svg").find("under-resolved"),
+            std::string::npos);
+}
+
+TEST(FitCli, AVersionOneDatabaseIsReadAndUpgradedByItsWriter) {
+  test::ScratchDir dir("fit");
+  write_synthetic_db(dir / "s.db", 8, {100.0}, known_laws(0.05),
+                     [](nlohmann::json& j) { j["base_scene"]["numerics"]["dx"] = 10.0; });
+  {
+    // Back to the layout of schema version 1: no under_resolved column.
+    Store store = Store::open_writer(dir / "s.db");
+    store.exec("ALTER TABLE cases DROP COLUMN under_resolved");
+    store.exec("PRAGMA user_version = 1");
+  }
+  const test::CliResult fit = test::run_cli(dir.path(), "fit s.db");
+  ASSERT_EQ(fit.code, 0) << fit.err;
+  EXPECT_NE(fit.out.find("5 under-resolved (excluded)"), std::string::npos) << fit.out;
+  { Store store = Store::open_writer(dir / "s.db"); }
+  EXPECT_EQ(test::dump_rows(dir / "s.db", "SELECT sum(under_resolved) FROM cases").at(0), "5");
+  EXPECT_EQ(test::dump_rows(dir / "s.db", "PRAGMA user_version").at(0), "2");
 }
 
 TEST(FitCli, DegenerateStudiesGiveNotEnoughDataRowsNeverACrash) {

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "analysis/crevasse_measure.hpp"
 #include "engine/error.hpp"
 #include "engine/scene.hpp"
 #include "study/shard.hpp"
@@ -356,8 +357,9 @@ TEST(Shard, ParsesAndRefuses) {
 namespace crevasse {
 namespace {
 
-// Every study shipped in studies/ loads (named after its file), and quick.json spans weak to
-// strong ice in 2D.
+// Every study shipped in studies/ loads (named after its file), and quick.json runs the flowing
+// glacier (draped over the whole bed, fed by an inflow, no ice cliff) from weak to strong ice in 2D,
+// with its strongest cases resolved (c/(ρ_i g) ≥ 3 dx).
 TEST(ShippedStudies, AllLoadAndQuickSpansWeakToStrongIce) {
   const std::filesystem::path dir = std::filesystem::path(CREVASSE_SOURCE_DIR) / "studies";
   int loaded = 0;
@@ -372,14 +374,20 @@ TEST(ShippedStudies, AllLoadAndQuickSpansWeakToStrongIce) {
   EXPECT_GE(loaded, 12);  // the studies of results/README.md
   const Study quick = load_study_file(dir / "quick.json");
   double lo = 1e9, hi = 0;
+  std::size_t resolved = 0;
   for (const auto& c : quick.cases) {
     EXPECT_EQ(c.scene.dim, 2);
-    EXPECT_LE(c.scene.ice_thickness, 100.0);
+    EXPECT_EQ(c.scene.drive_boundary, "inflow");
+    EXPECT_GT(c.scene.draped_length, c.scene.upstream_length + c.scene.step_length);
+    EXPECT_LE(c.scene.ice_thickness, 200.0);
     lo = std::min(lo, c.groups.cohesion_ratio);
     hi = std::max(hi, c.groups.cohesion_ratio);
+    const SceneConfig& sc = c.scene;
+    resolved += !analysis::strength_under_resolved(sc.tensile_strength, sc.density, sc.gravity, sc.dx);
   }
   EXPECT_LE(lo, 0.06);
   EXPECT_GE(hi, 0.9);
+  EXPECT_GE(resolved, 3u);
   EXPECT_LE(quick.cases.size(), 12u);
   // accuracy_drive's rows are accuracy_cost's cases at other drive speeds: the same scene
   // apart from drive.speed, so the table compares like with like.
@@ -397,12 +405,13 @@ TEST(ShippedStudies, AllLoadAndQuickSpansWeakToStrongIce) {
     }
     EXPECT_EQ(matched, 1);
   }
-  // three_d runs at cohesion ratios of quick's cases.
+  // three_d runs at cohesion ratios of cliff_quick's cases (its 2D counterpart on the diagram).
+  const Study cliff_quick = load_study_file(dir / "cliff_quick.json");
   const Study three = load_study_file(dir / "three_d.json");
   for (const auto& c : three.cases) {
     EXPECT_EQ(c.scene.dim, 3);
     bool matched = false;
-    for (const auto& q : quick.cases)
+    for (const auto& q : cliff_quick.cases)
       matched = matched || q.scene.tensile_strength == c.scene.tensile_strength;
     EXPECT_TRUE(matched) << c.label;
   }
