@@ -11,6 +11,7 @@
 
 #include "analysis/regime_diagram.hpp"
 #include "engine/error.hpp"
+#include "study/json_checks.hpp"
 #include "study/case_results.hpp"
 #include "study/csv_file.hpp"
 #include "study/store.hpp"
@@ -51,7 +52,9 @@ void read_cost_rows(const std::string& db_path, const std::string& prefix,
               "FROM cases");
   while (s.step()) {
     CostRow r;
-    const auto scene = nlohmann::json::parse(s.text(1));
+    const auto scene = parse_stored_json(s.text(1));
+    if (!scene.is_object())
+      throw InputError(db_path + ": case " + s.text(0) + ": its scene_json is not a valid scene");
     r.dx_m = scene.at("numerics").at("dx").get<double>();
     r.ppc_axis = scene.at("numerics").at("particles_per_cell_axis").get<int>();
     r.cfl = scene.at("numerics").at("cfl").get<double>();

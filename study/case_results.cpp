@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "engine/error.hpp"
+#include "study/json_checks.hpp"
 
 namespace crevasse {
 
@@ -86,7 +87,7 @@ std::vector<CaseRecord> read_case_records(Store& store) {
     for (auto& q : r.spacing_over_h) q = s.optional_real(k++);
     for (auto& q : r.depth_over_h) q = s.optional_real(k++);
     if (!s.is_null(k)) {
-      const auto j = nlohmann::json::parse(s.text(k), nullptr, false);
+      const auto j = parse_stored_json(s.text(k));
       if (j.is_array())
         for (const auto& v : j)
           if (v.is_number()) r.spacings_m.push_back(v.get<double>());

@@ -7,6 +7,7 @@
 #include <set>
 
 #include "engine/error.hpp"
+#include "study/json_checks.hpp"
 #include "study/csv_file.hpp"
 #include "study/fits_table.hpp"
 #include "study/store.hpp"
@@ -72,11 +73,11 @@ void export_cases(sqlite3* db, const fs::path& path) {
     for (int c : scalar_cols) row.push_back(s.is_null(c) ? "" : s.text(c));
     rows.push_back(std::move(row));
     std::map<std::string, std::string> f;
-    const auto axes = nlohmann::json::parse(s.text(axes_col), nullptr, false);
+    const auto axes = parse_stored_json(s.text(axes_col));
     if (axes.is_object())
       for (auto it = axes.begin(); it != axes.end(); ++it)
         f["axis." + it.key()] = json_scalar(it.value());
-    const auto scene = nlohmann::json::parse(s.text(scene_col), nullptr, false);
+    const auto scene = parse_stored_json(s.text(scene_col));
     if (!scene.is_discarded()) flatten(scene, "scene", f);
     for (const auto& [k, v] : f)
       if (flat_keys_set.insert(k).second) flat_keys.push_back(k);

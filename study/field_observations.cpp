@@ -54,12 +54,7 @@ std::optional<std::pair<double, double>> pair_around(const json& e, const std::s
 }  // namespace
 
 std::vector<FieldObservation> load_field_observations(const std::string& path) {
-  json doc;
-  try {
-    doc = json::parse(read_input_file(path, "--observations"));
-  } catch (const json::exception& e) {
-    throw InputError(path + ": not valid JSON: " + e.what());
-  }
+  const json doc = parse_json_input<json>(read_input_file(path, "--observations"), path);
   if (!doc.is_object() || !doc.contains("observations") || !doc["observations"].is_array() ||
       doc["observations"].empty())
     throw InputError(path + ": observations: needs a non-empty array of sites");

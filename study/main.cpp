@@ -21,18 +21,19 @@
 
 namespace {
 
-// The message on one line whatever it quotes from the input (a key with a newline in it).
-std::string one_line(const char* what) {
+// A message as one printable line of bounded length: it may echo user input (a key, a value), and
+// neither a terminal escape nor a megabyte of a bad value belongs on the user's terminal.
+std::string one_line(const std::string& what) {
+  constexpr std::size_t kMaxMessage = 600;
   std::string s;
-  for (const char* p = what; *p; ++p) {
-    if (*p == '\n') {
-      s += "\\n";
-    } else if (*p == '\r') {
-      s += "\\r";
-    } else {
-      s += *p;
-    }
+  for (const char c : what.substr(0, kMaxMessage)) {
+    if (c == '\n') s += "\\n";
+    else if (c == '\r') s += "\\r";
+    else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) s += '?';
+    else s += c;
   }
+  if (what.size() > kMaxMessage)
+    s += "... (" + std::to_string(what.size() - kMaxMessage) + " more bytes)";
   return s;
 }
 
@@ -152,7 +153,7 @@ int main(int argc, char** argv) {
 
   // Parse errors on one line, like every other refusal.
   app.failure_message([](const CLI::App*, const CLI::Error& e) {
-    return std::string("crevasse: error: ") + e.what() + "\n";
+    return "crevasse: error: " + one_line(e.what()) + "\n";
   });
 
   for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))

@@ -55,11 +55,30 @@ MergeReport merge_databases(const fs::path& out, const std::vector<fs::path>& in
     if (fs::exists(out) && fs::equivalent(in, out, ec))
       throw InputError("merge: input " + in.string() +
                        " is the output database; give a new OUT path");
-    // Exists and is a study database of this schema (the tables are copied column by column).
-    if (Store::open_reader(in).schema_version() != kStoreSchemaVersion)
-      throw InputError("merge: " + in.string() + " was written by an older crevasse (schema " +
-                       "version 1); resume its study once with this crevasse to upgrade it");
   }
+  // Every input is checked before OUT is opened, so a refusal writes nothing: each exists, is a
+  // study database of this schema (the tables are copied column by column), and all hold one
+  // study, the one already in OUT if OUT exists.
+  std::optional<std::string> study;
+  std::string study_from;
+  const auto same_study = [&](const fs::path& db, bool output) {
+    Store reader = Store::open_reader(db);
+    if (reader.schema_version() != kStoreSchemaVersion)
+      throw InputError("merge: " + db.string() + " was written by an older crevasse (schema " +
+                       "version 1); resume its study once with this crevasse to upgrade it");
+    const std::optional<std::string> hash = reader.study_hash();
+    if (!hash) {
+      if (output) return;
+      throw InputError("merge: " + db.string() + ": holds no study (was it ever run?)");
+    }
+    if (study && *study != *hash)
+      throw InputError("merge: " + db.string() + " holds another study than " + study_from +
+                       " (other cases or engine version); merge only databases of one study");
+    study = hash;
+    study_from = db.string();
+  };
+  if (fs::exists(out, ec)) same_study(out, true);
+  for (const auto& in : inputs) same_study(in, false);
   MergeReport report;
   Store store = Store::open_writer(out);
   for (const auto& in : inputs) {

@@ -121,12 +121,6 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
     cdf_cases.push_back(&*it);
   }
 
-  std::error_code ec;
-  fs::create_directories(opt.out_dir, ec);
-  if (ec || !fs::is_directory(opt.out_dir))
-    throw InputError("--out: cannot create directory " + opt.out_dir +
-                     (ec ? " (" + ec.message() + ")" : ""));
-
   // The cases drawn: the study's own, then those of --add-cases (label prefix, not fitted).
   std::vector<std::vector<CaseRecord>> added;
   std::vector<std::string> added_names;
@@ -136,6 +130,12 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
     added_names.push_back(s.step() ? s.text(0) : path);
     added.push_back(read_case_records(other));
   }
+  // Only once every input has been read: a refusal leaves no folder behind.
+  std::error_code ec;
+  fs::create_directories(opt.out_dir, ec);
+  if (ec || !fs::is_directory(opt.out_dir))
+    throw InputError("--out: cannot create directory " + opt.out_dir +
+                     (ec ? " (" + ec.message() + ")" : ""));
   std::vector<std::pair<const CaseRecord*, std::string>> drawn_cases;
   for (const CaseRecord& c : cases) drawn_cases.emplace_back(&c, "");
   for (std::size_t k = 0; k < added.size(); ++k)

@@ -191,7 +191,8 @@ RunnerReport run_study(const Study& study, const RunnerOptions& opt) {
   tbb::global_control parallelism(
       tbb::global_control::max_allowed_parallelism,
       static_cast<std::size_t>(std::max(1, jobs * report.threads_per_case)));
-  std::atomic<bool> stop{false};
+  std::atomic<bool> own_stop{false};
+  std::atomic<bool>& stop = opt.interrupt ? *opt.interrupt : own_stop;
   std::atomic<std::size_t> next{0};
   std::vector<std::atomic<double>> fraction(todo.size());
   for (auto& f : fraction) f.store(0.0);
@@ -383,8 +384,10 @@ RunnerReport run_study(const Study& study, const RunnerOptions& opt) {
   if (worker_error) std::rethrow_exception(worker_error);
 
   report.stopped = opt.fail_fast && report.failed > 0;
+  report.interrupted_by_request = opt.interrupt && opt.interrupt->load() && !report.stopped &&
+                                  !writer_error && !worker_error;
   report.wall_s = seconds_since(t0);
-  const std::string outcome = report.stopped                              ? "stopped"
+  const std::string outcome = report.stopped || report.interrupted_by_request ? "stopped"
                               : report.failed + report.already_failed > 0 ? "failures"
                                                                           : "complete";
   store.end_session(session_id, outcome, static_cast<std::int64_t>(report.ran));

@@ -90,6 +90,7 @@ struct RunnerReport {
   std::size_t interrupted = 0;     // left 'running' by a killed run, run again
   std::size_t ran = 0, done = 0, failed = 0, cancelled = 0;
   bool stopped = false;       // --fail-fast stopped the run
+  bool interrupted_by_request = false;  // RunnerOptions::interrupt ended the session
   std::string first_failure;  // "label: reason"
   double wall_s = 0.0;
   int jobs = 0, threads_per_case = 0;
@@ -117,6 +118,9 @@ struct RunnerOptions {
   CaseFunction case_function;  // empty: run_engine_case (engine_case.hpp)
   StudyObserver* observer = nullptr;
   std::filesystem::path views_dir;  // non-empty: each case writes its side views there
+  // Set from outside (a signal handler) to end the session early: no new case starts, and the
+  // running ones save a checkpoint and stay pending for the next session (report.interrupted).
+  std::atomic<bool>* interrupt = nullptr;
 };
 
 // Throws InputError before anything runs when the database is unusable or holds another study.

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "engine/error.hpp"
+#include "study/json_checks.hpp"
 
 namespace crevasse {
 namespace {
@@ -113,13 +114,7 @@ std::string read_input_file(const std::filesystem::path& path, const std::string
 }
 
 SceneConfig parse_scene_text(const std::string& text, const std::string& source) {
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception& e) {
-    // parse_error, and out_of_range for numbers beyond double (1e400).
-    throw InputError(source + ": not valid JSON (" + std::string(e.what()) + ")");
-  }
+  const nlohmann::json j = parse_json_input<nlohmann::json>(text, source);
   SceneConfig scene = scene_from_json(j);
   check_scene_json(j, scene);
   return scene;

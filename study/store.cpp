@@ -4,8 +4,10 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <ctime>
 #include <stdexcept>
@@ -254,23 +256,48 @@ std::int64_t table_count(sqlite3* db) {
 
 }  // namespace
 
-Store Store::open_writer(const fs::path& path) {
+Store Store::open_writer(const fs::path& path, double wait_s) {
   const std::string where = "--db " + path.string();
   std::error_code ec;
-  if (path.has_parent_path()) {
+  const bool existed = fs::exists(path, ec);  // follows symbolic links
+  if (existed && !fs::is_regular_file(path, ec))
+    throw InputError(where + ": not a regular file; a study database is an ordinary file");
+  // Whatever this call creates is removed again when it refuses: the file system is left as found.
+  fs::path created_dir;
+  if (path.has_parent_path() && !fs::exists(path.parent_path(), ec)) {
+    for (fs::path p = path.parent_path(); !p.empty() && !fs::exists(p, ec); p = p.parent_path())
+      created_dir = p;
     fs::create_directories(path.parent_path(), ec);
     if (ec)
       throw InputError(where + ": cannot create directory " + path.parent_path().string() + " (" +
                        ec.message() + ")");
   }
-  const std::string lock_path = path.string() + ".lock";
-  const int fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (fd < 0)
-    throw InputError(where + ": cannot create " + lock_path + " (" + std::strerror(errno) + ")");
-  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+  const auto undo = [&] {
+    if (!existed) fs::remove(path, ec);
+    if (!created_dir.empty()) fs::remove_all(created_dir, ec);
+  };
+  const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    const std::string why = std::strerror(errno);
+    undo();
+    throw InputError(where + ": cannot open (" + why + ")");
+  }
+  // One writer per file, whatever path names it: the flock is on the database file itself, so a
+  // symbolic or hard link to it meets the same lock. (SQLite's own locks are POSIX record locks,
+  // which do not interact with flock on Linux.) Readers hold a shared lock for a moment while no
+  // writer runs, so a writer waits up to 10 s before it gives up.
+  bool locked = false;
+  for (int tries = 0; !locked; ++tries) {
+    locked = ::flock(fd, LOCK_EX | LOCK_NB) == 0;
+    if (locked || errno != EWOULDBLOCK || tries >= wait_s * 10.0) break;
+    ::usleep(100000);
+  }
+  if (!locked) {
     ::close(fd);
-    throw InputError(where + ": another crevasse process is writing to this database (" +
-                     lock_path + " is locked); wait for it to end or use another --db");
+    undo();
+    throw InputError(where +
+                     ": another crevasse process is writing to this database (the file is "
+                     "locked); wait for it to end or use another --db");
   }
   sqlite3* db = nullptr;
   if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr) !=
@@ -278,6 +305,7 @@ Store Store::open_writer(const fs::path& path) {
     const std::string msg = db ? sqlite3_errmsg(db) : "out of memory";
     sqlite3_close_v2(db);
     ::close(fd);
+    undo();
     throw InputError(where + ": cannot open the database (" + msg + ")");
   }
   Store store(db, path, fd);
@@ -300,7 +328,7 @@ Store Store::open_writer(const fs::path& path) {
     }
     store.exec("PRAGMA synchronous = FULL");
     store.exec("PRAGMA foreign_keys = ON");
-    store.transaction([&] {
+    if (version != kStoreSchemaVersion) store.transaction([&] {
       if (version == 1) {
         store.exec("ALTER TABLE cases ADD COLUMN under_resolved INTEGER NOT NULL DEFAULT 0");
         store.exec(std::string("UPDATE cases SET under_resolved = ") + kUnderResolvedSql);
@@ -317,14 +345,44 @@ Store Store::open_writer(const fs::path& path) {
 
 Store Store::open_reader(const fs::path& path) {
   const std::string where = path.string();
-  if (!fs::exists(path)) throw InputError(where + ": no such database");
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw InputError(where + ": no such database");
+  // A FIFO or device would block the open or the first read forever.
+  if (!fs::is_regular_file(path, ec))
+    throw InputError(where + ": not a regular file; a study database is an ordinary file");
+  // With no writer (the shared lock is granted) and no WAL left by a killed one, the file is
+  // read as immutable: nothing is created beside it (-wal, -shm), and the shared lock, held
+  // until the reader closes, keeps a writer from starting meanwhile. With a writer running,
+  // it is read through the writer's WAL as usual.
+  int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw InputError(where + ": cannot open (" + std::strerror(errno) + ")");
+  const fs::path wal = path.string() + "-wal";
+  const bool quiet = ::flock(fd, LOCK_SH | LOCK_NB) == 0 &&
+                     (!fs::exists(wal, ec) || fs::file_size(wal, ec) == 0);
+  if (!quiet) {
+    ::close(fd);
+    fd = -1;
+  }
+  std::string uri = "file:";
+  for (const unsigned char c : fs::absolute(path, ec).string()) {
+    if (std::isalnum(c) || c == '/' || c == '.' || c == '-' || c == '_') {
+      uri += static_cast<char>(c);
+    } else {
+      char hex[4];
+      std::snprintf(hex, sizeof hex, "%%%02X", c);
+      uri += hex;
+    }
+  }
+  if (quiet) uri += "?immutable=1";
   sqlite3* db = nullptr;
-  if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
+  if (sqlite3_open_v2(uri.c_str(), &db, SQLITE_OPEN_READONLY | SQLITE_OPEN_URI, nullptr) !=
+      SQLITE_OK) {
     const std::string msg = db ? sqlite3_errmsg(db) : "out of memory";
     sqlite3_close_v2(db);
+    if (fd >= 0) ::close(fd);
     throw InputError(where + ": cannot open the database (" + msg + ")");
   }
-  Store store(db, path, -1);
+  Store store(db, path, fd);
   sqlite3_busy_timeout(db, 10000);
   int version = 0;
   try {

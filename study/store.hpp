@@ -1,8 +1,9 @@
 #pragma once
 // The SQLite file of one study (docs/study_format.md; schema in docs/database.md): tables study, sessions,
 // cases, crevasses, summaries. WAL journal, so readers (crevasse status, sqlite3) never block the
-// writer and never see a half-written case; exactly one writer, enforced by an flock on
-// "<db>.lock" that the kernel releases even when the writer is killed. Every finished case is
+// writer and never see a half-written case; exactly one writer, enforced by an flock on the
+// database file itself (so on the file, not on the path that names it) that the kernel
+// releases even when the writer is killed. Every finished case is
 // written in one transaction, so a SIGKILL leaves each case either wholly stored or not at all.
 #include <sqlite3.h>
 
@@ -103,8 +104,9 @@ struct SessionInfo {
 class Store {
  public:
   // Opens (creating when absent) the database as its one writer: takes the lock, sets WAL,
-  // creates the schema. Throws InputError when the path is unusable or another writer holds it.
-  static Store open_writer(const std::filesystem::path& path);
+  // creates the schema. Throws InputError when the path is unusable or another writer still
+  // holds the file after `wait_s` seconds.
+  static Store open_writer(const std::filesystem::path& path, double wait_s = 10.0);
   // Opens an existing database read-only. Throws InputError when it does not exist or is not a
   // crevasse study database.
   static Store open_reader(const std::filesystem::path& path);

@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <atomic>
+#include <csignal>
 #include <cstdio>
 
 #include "study/progress_printer.hpp"
@@ -11,6 +13,28 @@
 
 namespace crevasse {
 namespace {
+
+// Ctrl-C (SIGINT), SIGTERM and SIGHUP end a study cleanly: the handler only raises a flag, the
+// running cases save their checkpoint and stay pending, the session is closed as "stopped", and
+// the process exits with 128 + the signal number. A second signal of the same kind kills at once
+// (the handler gives the default action back).
+std::atomic<bool> g_interrupt{false};
+volatile std::sig_atomic_t g_signal = 0;
+
+extern "C" void on_interrupt_signal(int sig) {
+  g_signal = sig;
+  g_interrupt.store(true);
+  std::signal(sig, SIG_DFL);
+}
+
+struct InterruptHandlers {
+  InterruptHandlers() {
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, on_interrupt_signal);
+  }
+  ~InterruptHandlers() {
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, SIG_DFL);
+  }
+};
 
 std::string case_wall(double s) {
   if (s >= 60) return format_duration(s);
@@ -141,8 +165,18 @@ int study_command(const StudyCommandOptions& opt) {
   ro.command = opt.command_line;
   ro.views_dir = opt.views_dir;
   ro.observer = opt.quiet ? nullptr : &console;
+  const InterruptHandlers handlers;
+  ro.interrupt = &g_interrupt;
   const RunnerReport r = run_study(study, ro);
   const std::size_t failed = r.failed + r.already_failed;
+  if (r.interrupted_by_request) {
+    const int sig = g_signal;
+    std::fprintf(stderr,
+                 "crevasse: interrupted by signal %d; the running cases saved a checkpoint and "
+                 "continue from it when you run the same command again\n",
+                 sig);
+    return 128 + sig;
+  }
   if (r.stopped) {
     std::fprintf(stderr, "crevasse: stopped at the first failure (--fail-fast): %s\n",
                  r.first_failure.c_str());

@@ -171,11 +171,7 @@ double number_at(const json& j, const std::string& ptr, double fallback) {
 }
 
 json read_json_text(const std::string& text, const std::string& source) {
-  try {
-    return json::parse(text);
-  } catch (const json::exception& e) {  // also out_of_range: 1e400
-    throw InputError(source + ": not valid JSON (" + e.what() + ")");
-  }
+  return parse_json_input<json>(text, source);
 }
 
 std::string read_text(const std::filesystem::path& path, const std::string& field) {
@@ -328,12 +324,7 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
                   const std::string& source) {
   Study st;
   st.source_text = text;
-  ordered_json doc;
-  try {
-    doc = ordered_json::parse(text);
-  } catch (const json::exception& e) {  // also out_of_range: 1e400
-    throw InputError(source + ": not valid JSON (" + e.what() + ")");
-  }
+  const ordered_json doc = parse_json_input<ordered_json>(text, source);
   if (!doc.is_object()) fail(source, "a study file must be a JSON object");
   refuse_unknown_keys(doc, "",
                  {"name", "description", "base_scene", "fixed", "sweep", "replicas", "measurement",
