@@ -208,6 +208,15 @@ void SceneConfig::resolve() {
     check_range("ice.softening.zeta_ref", zeta_ref, 0.0, 1e9, true);
     check_range("ice.softening.dx_ref", dx_ref, 0.0, 1e4, true);
     check_range("ice.softening.residual_friction", residual_friction, 0.0, 10.0);
+    // ζ from one source only: a scene written by scene_to_json carries the ζ its G implied,
+    // which is accepted; a ζ that disagrees with G would be used while G was ignored.
+    if (softening_zeta > 0.0 && fracture_energy > 0.0 &&
+        std::abs(softening_zeta - tensile_strength * dx / fracture_energy) >
+            1e-9 * softening_zeta)
+      fail("ice.softening.fracture_energy",
+           "give zeta or fracture_energy, not both (zeta " + std::to_string(softening_zeta) +
+               " disagrees with c dx / fracture_energy = " +
+               std::to_string(tensile_strength * dx / fracture_energy) + ")");
     if (softening_zeta == 0.0) {
       softening_zeta = fracture_energy > 0 ? tensile_strength * dx / fracture_energy
                                            : zeta_ref * dx / dx_ref;
@@ -410,6 +419,9 @@ SceneConfig scene_from_json(const nlohmann::json& j) {
   }
   if (const auto* vb = r.child("velocity_boxes")) {
     if (!vb->is_array()) fail("velocity_boxes", "must be an array");
+    // Each box is tested on every grid node each step: thousands make a run crawl.
+    if (vb->size() > 1000)
+      fail("velocity_boxes", "holds " + std::to_string(vb->size()) + " boxes; at most 1000");
     for (std::size_t i = 0; i < vb->size(); ++i) {
       ObjectReader o((*vb)[i], "velocity_boxes[" + std::to_string(i) + "]");
       VelocityBox b;

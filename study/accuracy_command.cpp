@@ -5,7 +5,9 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
+#include <tuple>
 
 #include <nlohmann/json.hpp>
 
@@ -90,6 +92,15 @@ std::vector<fs::path> accuracy_report(const AccuracyCommandOptions& opt, std::st
       throw InputError("--add-cases: " + opt.add_dbs[i] + " has no finished case");
   }
   if (main_rows == 0) throw InputError(opt.db_path + ": no finished case; run the study first");
+  {
+    // A table of accuracy against cost needs runs that differ in their numerics.
+    std::set<std::tuple<double, int, double, double>> numerics;
+    for (const CostRow& r : rows) numerics.emplace(r.dx_m, r.ppc_axis, r.cfl, r.drive_m_s.value_or(0.0));
+    if (numerics.size() < 2)
+      throw InputError(opt.db_path + ": every finished case has the same numerics (dx, particles "
+                       "per cell, CFL, drive speed); accuracy compares runs that differ in them "
+                       "(e.g. studies/accuracy_cost.json)");
+  }
   // Coarsest grid first (the figure's colours and legend follow this order), then case order.
   std::stable_sort(rows.begin(), rows.end(),
                    [](const CostRow& a, const CostRow& b) { return a.dx_m > b.dx_m; });

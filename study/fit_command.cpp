@@ -157,7 +157,7 @@ int fit_command(const FitCommandOptions& opt) {
   }
   std::optional<Store> opened;
   try {
-    opened.emplace(Store::open_writer(opt.db_path));
+    opened.emplace(Store::open_writer(opt.db_path, 10.0, ""));
   } catch (const InputError& e) {
     throw InputError(opt.db_path + ": cannot store the fits (" + e.what() +
                      "); run crevasse fit again when the study has ended, or add --no-store");

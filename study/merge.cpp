@@ -80,7 +80,7 @@ MergeReport merge_databases(const fs::path& out, const std::vector<fs::path>& in
   if (fs::exists(out, ec)) same_study(out, true);
   for (const auto& in : inputs) same_study(in, false);
   MergeReport report;
-  Store store = Store::open_writer(out);
+  Store store = Store::open_writer(out, 10.0, "merge: OUT");
   for (const auto& in : inputs) {
     {
       Statement a(store.handle(), "ATTACH DATABASE ? AS src");

@@ -256,8 +256,8 @@ std::int64_t table_count(sqlite3* db) {
 
 }  // namespace
 
-Store Store::open_writer(const fs::path& path, double wait_s) {
-  const std::string where = "--db " + path.string();
+Store Store::open_writer(const fs::path& path, double wait_s, const std::string& option) {
+  const std::string where = (option.empty() ? "" : option + " ") + path.string();
   std::error_code ec;
   const bool existed = fs::exists(path, ec);  // follows symbolic links
   if (existed && !fs::is_regular_file(path, ec))
@@ -297,7 +297,8 @@ Store Store::open_writer(const fs::path& path, double wait_s) {
     undo();
     throw InputError(where +
                      ": another crevasse process is writing to this database (the file is "
-                     "locked); wait for it to end or use another --db");
+                     "locked); wait for it to end" +
+                     (option == "--db" ? std::string(" or use another --db") : std::string()));
   }
   sqlite3* db = nullptr;
   if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr) !=

@@ -106,7 +106,9 @@ class Store {
   // Opens (creating when absent) the database as its one writer: takes the lock, sets WAL,
   // creates the schema. Throws InputError when the path is unusable or another writer still
   // holds the file after `wait_s` seconds.
-  static Store open_writer(const std::filesystem::path& path, double wait_s = 10.0);
+  // `option` names the path in messages as the command line gave it ("--db", "OUT"; "" for none).
+  static Store open_writer(const std::filesystem::path& path, double wait_s = 10.0,
+                           const std::string& option = "--db");
   // Opens an existing database read-only. Throws InputError when it does not exist or is not a
   // crevasse study database.
   static Store open_reader(const std::filesystem::path& path);

@@ -2,9 +2,11 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <csignal>
 #include <cstdio>
+#include <thread>
 
 #include "study/progress_printer.hpp"
 #include "study/runner.hpp"
@@ -153,6 +155,14 @@ int study_command(const StudyCommandOptions& opt) {
       db += ".shard-" + std::to_string(shard->index) + "-of-" + std::to_string(shard->count);
     db += ".db";
   }
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const int threads_asked =
+      opt.threads_per_case > 0 ? opt.threads_per_case : study.resources.threads_per_case;
+  if (threads_asked > static_cast<int>(cores))
+    std::fprintf(stderr,
+                 "crevasse: warning: %d engine threads per case on %u core(s): the threads share "
+                 "the cores, so each case runs no faster and usually slower\n",
+                 threads_asked, cores);
   ConsoleObserver console(study.name, db);
   RunnerOptions ro;
   ro.db_path = db;

@@ -337,7 +337,10 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
       !std::all_of(st.name.begin(), st.name.end(), [](char c) {
         return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.';
       }))
-    fail("name", "'" + st.name + "' must be 1 to 64 characters from A-Z a-z 0-9 _ - .");
+    fail("name", "'" + printable(st.name.substr(0, 64)) + "' must be 1 to 64 characters from A-Z a-z 0-9 _ - .");
+  // It names files (results/<name>.db): no hidden file, no "." or "..".
+  if (st.name.front() == '.')
+    fail("name", "'" + st.name + "' must not start with '.' (it names the database file)");
   if (doc.contains("description")) {
     if (!doc.at("description").is_string()) fail("description", "must be a string");
     st.description = doc.at("description").get<std::string>();

@@ -23,10 +23,12 @@ std::optional<double> parse_exponent(const std::string& text, const std::string&
   try {
     std::size_t used = 0;
     const double v = std::stod(text, &used);
-    if (used == text.size() && std::isfinite(v)) return v;
+    // A fitted log-log exponent beyond ±100 would overflow Π^b over any sensible range.
+    if (used == text.size() && std::isfinite(v) && std::abs(v) <= 100.0) return v;
   } catch (const std::exception&) {
   }
-  throw InputError(option + ": '" + text + "' is not an exponent; give a number or 'free'");
+  throw InputError(option + ": '" + text +
+                   "' is not an exponent; give a number in [-100, 100] or 'free'");
 }
 
 }  // namespace

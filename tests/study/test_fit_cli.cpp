@@ -369,12 +369,21 @@ TEST(FitCli, PlotAddsCasesOfAnotherStudy) {
 // particle-steps that has a spacing, changes are relative to it, and the figure is written.
 TEST(FitCli, AccuracyTableAgainstTheFinestRun) {
   test::ScratchDir dir("fit");
-  write_synthetic_db(dir / "s.db", 5, {100.0}, [](const StudyCase& c) {
+  const auto make = [](const StudyCase& c) {
     FakeResult f;
     f.spacing_over_h = 1.0 + 0.1 * static_cast<double>(c.index);  // the last (finest) is 1.4
     f.depth_over_h = 1.0;
     if (c.index == 0) f.kind = FakeResult::no_crevasse;
     return f;
+  };
+  // A study that does not vary the numerics has nothing to compare: refused, naming the database.
+  write_synthetic_db(dir / "same.db", 5, {100.0}, make);
+  expect_one_line_error(test::run_cli(dir.path(), "accuracy same.db --out same"),
+                        "same numerics");
+  EXPECT_FALSE(std::filesystem::exists(dir / "same"));
+  write_synthetic_db(dir / "s.db", 5, {100.0}, make, [](nlohmann::json& j) {
+    j["fixed"]["cohesion_ratio"] = 0.3;
+    j["sweep"] = {{"/numerics/dx", {5.0, 4.0, 3.0, 2.0, 1.0}}};
   });
   const test::CliResult r = test::run_cli(dir.path(), "accuracy s.db --out acc");
   ASSERT_EQ(r.code, 0) << r.err;

@@ -169,6 +169,58 @@ TEST(HostileInputs, ARefusedCommandLeavesTheFileSystemAsItFoundIt) {
   EXPECT_EQ(test::read_file(dir / "a.db"), a_bytes) << "the refused study wrote to a.db";
 }
 
+TEST(HostileInputs, AmbiguousOrOutOfRangeValuesAreRefusedNamingTheField) {
+  test::ScratchDir dir("hostile");
+  nlohmann::json scene = test::tiny_scene(20);
+  scene["effects"] = {"gravity", "drive", "basal_friction", "plasticity", "softening", "outflow"};
+  scene["ice"]["softening"] = {{"zeta", 300.0}, {"fracture_energy", 50.0}};
+  test::write_text(dir / "both.json", scene.dump());
+  expect_refusal(run_cli(dir.path(), "run both.json --out o"), "ice.softening.fracture_energy");
+  // ζ and G that agree (as scene_to_json writes them) are one source, accepted.
+  scene["ice"]["softening"] = {{"fracture_energy", 50.0}};
+  test::write_text(dir / "g.json", scene.dump());
+  ASSERT_EQ(run_cli(dir.path(), "run g.json --out g --quiet").code, 0);
+  EXPECT_EQ(run_cli(dir.path(), "run g/scene_resolved.json --out g2 --quiet").code, 0);
+
+  nlohmann::json boxes = test::tiny_scene(20);
+  boxes["effects"].push_back("velocity_boundaries");
+  boxes["velocity_boxes"] = nlohmann::json::array();
+  for (int i = 0; i < 1001; ++i)
+    boxes["velocity_boxes"].push_back({{"min", {0.0, 0.0}}, {"max", {1.0, 1.0}}, {"velocity", {0.0, 0.0}}});
+  test::write_text(dir / "boxes.json", boxes.dump());
+  expect_refusal(run_cli(dir.path(), "run boxes.json --out b"), "velocity_boxes");
+
+  for (const char* name : {"..", ".", ".hidden"}) {
+    nlohmann::json j = test::tiny_study(2, 20, name);
+    test::write_text(dir / "n.json", j.dump());
+    expect_refusal(run_cli(dir.path(), "study n.json --dry-run"), "name");
+  }
+  tiny_db(dir.path(), "t", 4);
+  for (const char* fixed : {"1e308,free", "free,-101"})
+    expect_refusal(run_cli(dir.path(), std::string("fit t.db --fixed-exponents ") + fixed),
+                   "--fixed-exponents");
+  const auto warned = run_cli(dir.path(), "study t.json --db t.db --threads-per-case 1024 --quiet");
+  EXPECT_EQ(warned.code, 0) << warned.err;
+  EXPECT_NE(warned.err.find("warning: 1024 engine threads per case"), std::string::npos)
+      << warned.err;
+}
+
+TEST(HostileInputs, MessagesBlameTheRightFileAndCiteOnlyOptionsTheCommandHas) {
+  test::ScratchDir dir("hostile");
+  tiny_db(dir.path(), "t");
+  test::write_text(dir / "corrupt.db", std::string(8192, 'x'));
+  const auto merged = run_cli(dir.path(), "merge out.db corrupt.db");
+  expect_refusal(merged, "corrupt.db");
+  EXPECT_EQ(merged.err.find("out.db"), std::string::npos) << merged.err;
+  EXPECT_FALSE(fs::exists(dir / "out.db"));
+  Store writer = Store::open_writer(dir / "t.db", 0.0);
+  for (const std::string cmd : {"fit t.db", "merge t.db t.db"}) {
+    const auto r = run_cli(dir.path(), cmd);
+    EXPECT_NE(r.code, 0) << cmd;
+    EXPECT_EQ(r.err.find("--db"), std::string::npos) << cmd << ": " << r.err;
+  }
+}
+
 TEST(HostileInputs, CtrlCCheckpointsTheRunningCaseAndTheSameCommandResumesIt) {
   test::ScratchDir dir("hostile");
   nlohmann::json study = test::tiny_study(2, 400000, "sig");
