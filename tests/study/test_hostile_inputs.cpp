@@ -213,6 +213,8 @@ TEST(HostileInputs, MessagesBlameTheRightFileAndCiteOnlyOptionsTheCommandHas) {
   expect_refusal(merged, "corrupt.db");
   EXPECT_EQ(merged.err.find("out.db"), std::string::npos) << merged.err;
   EXPECT_FALSE(fs::exists(dir / "out.db"));
+  expect_refusal(run_cli(dir.path(), "export corrupt.db --csv cc"), "corrupt.db");
+  EXPECT_FALSE(fs::exists(dir / "cc")) << "a refused export leaves no partial CSV folder";
   Store writer = Store::open_writer(dir / "t.db", 0.0);
   for (const std::string cmd : {"fit t.db", "merge t.db t.db"}) {
     const auto r = run_cli(dir.path(), cmd);
