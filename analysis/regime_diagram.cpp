@@ -230,9 +230,8 @@ Figure regime_diagram(const std::vector<RegimePoint>& points, const RegimeFit& f
     }
     const Color color = palette_color(g);
     figure.add_error_bars(x_bar, lo, hi, color.with_alpha(0.8));
-    if (!x.empty() || hollow.empty())
-      figure.add_points(x, y, {palette_marker(g), color, 6.5, true},
-                        groups[g].empty() ? "cases" : groups[g]);
+    figure.add_points(x, y, {palette_marker(g), color, 6.5, true},
+                      groups[g].empty() ? "cases" : groups[g]);
     for (const auto& [reason, xy] : hollow) {
       const bool named =
           std::find(hollow_reasons.begin(), hollow_reasons.end(), reason) != hollow_reasons.end();

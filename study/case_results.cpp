@@ -66,7 +66,7 @@ std::vector<CaseRecord> read_case_records(Store& store) {
               "m.fragmented, m.spacing_q25_over_h, m.spacing_median_over_h, "
               "m.spacing_q75_over_h, m.depth_q25_over_h, m.depth_median_over_h, "
               "m.depth_q75_over_h, m.spacings_json, " +
-              std::string(store.schema_version() >= 2 ? "c.under_resolved" : kUnderResolvedSql) +
+              store.under_resolved_column() +
               " FROM cases c LEFT JOIN summaries m USING (case_id) ORDER BY c.case_index, "
               "c.replica, c.case_id");
   std::vector<CaseRecord> out;

@@ -13,6 +13,7 @@
 #include "study/calibrate_command.hpp"
 #include "study/export_command.hpp"
 #include "study/fit_command.hpp"
+#include "study/json_checks.hpp"
 #include "study/merge.hpp"
 #include "study/plot_command.hpp"
 #include "study/run_command.hpp"
@@ -26,12 +27,9 @@ namespace {
 std::string one_line(const std::string& what) {
   constexpr std::size_t kMaxMessage = 600;
   std::string s;
-  for (const char c : what.substr(0, kMaxMessage)) {
-    if (c == '\n') s += "\\n";
-    else if (c == '\r') s += "\\r";
-    else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) s += '?';
-    else s += c;
-  }
+  for (const char c : what.substr(0, kMaxMessage))
+    s += c == '\n' ? std::string("\\n") : c == '\r' ? std::string("\\r") : std::string(1, c);
+  s = crevasse::printable(s);
   if (what.size() > kMaxMessage)
     s += "... (" + std::to_string(what.size() - kMaxMessage) + " more bytes)";
   return s;

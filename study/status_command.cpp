@@ -99,7 +99,7 @@ int status_command(const StatusCommandOptions& opt) {
         "c.slope, m.crevasse_count, m.spacing_median_over_h, m.depth_median_over_h, c.wall_s, "
         "c.label, "
         "m.fragmented, " +
-            std::string(store.schema_version() >= 2 ? "c.under_resolved" : kUnderResolvedSql) +
+            store.under_resolved_column() +
             " FROM cases c LEFT JOIN summaries m USING (case_id) WHERE c.status = 'done' "
             "ORDER BY c.case_index LIMIT ?");
     s.bind(1, static_cast<std::int64_t>(limit));

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <ctime>
 #include <stdexcept>
+#include <vector>
 
 #include "analysis/measurement_io.hpp"
 #include "engine/error.hpp"
@@ -244,6 +245,13 @@ void Store::exec(const std::string& sql) {
 
 namespace {
 
+// analysis::strength_under_resolved over a cases row, for files written before the column.
+std::string under_resolved_rule_sql() {
+  return "(tensile_strength_pa / (json_extract(scene_json, '$.ice.density') * "
+         "json_extract(scene_json, '$.gravity.g')) < " +
+         std::to_string(analysis::kStrengthLengthMinCells) + " * dx_m)";
+}
+
 int read_user_version(sqlite3* db) {
   Statement s(db, "PRAGMA user_version");
   return s.step() ? static_cast<int>(s.integer(0)) : 0;
@@ -259,24 +267,28 @@ std::int64_t table_count(sqlite3* db) {
 Store Store::open_writer(const fs::path& path, double wait_s, const std::string& option) {
   const std::string where = (option.empty() ? "" : option + " ") + path.string();
   std::error_code ec;
-  const bool existed = fs::exists(path, ec);  // follows symbolic links
-  if (existed && !fs::is_regular_file(path, ec))
+  if (fs::exists(path, ec) && !fs::is_regular_file(path, ec))  // follows symbolic links
     throw InputError(where + ": not a regular file; a study database is an ordinary file");
-  // Whatever this call creates is removed again when it refuses: the file system is left as found.
-  fs::path created_dir;
-  if (path.has_parent_path() && !fs::exists(path.parent_path(), ec)) {
-    for (fs::path p = path.parent_path(); !p.empty() && !fs::exists(p, ec); p = p.parent_path())
-      created_dir = p;
+  // What this call creates is removed again when it refuses, so the file system is left as
+  // found; only what it created (O_EXCL says so) and, for the file, only while it holds the
+  // lock, so another process's new database is never removed.
+  std::vector<fs::path> created_dirs;  // deepest first
+  for (fs::path p = path.parent_path(); !p.empty() && !fs::exists(p, ec); p = p.parent_path())
+    created_dirs.push_back(p);
+  if (!created_dirs.empty()) {
     fs::create_directories(path.parent_path(), ec);
     if (ec)
       throw InputError(where + ": cannot create directory " + path.parent_path().string() + " (" +
                        ec.message() + ")");
   }
+  bool created = false, locked = false;
   const auto undo = [&] {
-    if (!existed) fs::remove(path, ec);
-    if (!created_dir.empty()) fs::remove_all(created_dir, ec);
+    if (created && locked) fs::remove(path, ec);
+    for (const fs::path& d : created_dirs) fs::remove(d, ec);  // only while empty
   };
-  const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  created = fd >= 0;
+  if (!created && errno == EEXIST) fd = ::open(path.c_str(), O_RDWR | O_CLOEXEC);
   if (fd < 0) {
     const std::string why = std::strerror(errno);
     undo();
@@ -286,15 +298,14 @@ Store Store::open_writer(const fs::path& path, double wait_s, const std::string&
   // symbolic or hard link to it meets the same lock. (SQLite's own locks are POSIX record locks,
   // which do not interact with flock on Linux.) Readers hold a shared lock for a moment while no
   // writer runs, so a writer waits up to 10 s before it gives up.
-  bool locked = false;
   for (int tries = 0; !locked; ++tries) {
     locked = ::flock(fd, LOCK_EX | LOCK_NB) == 0;
     if (locked || errno != EWOULDBLOCK || tries >= wait_s * 10.0) break;
     ::usleep(100000);
   }
   if (!locked) {
-    ::close(fd);
     undo();
+    ::close(fd);
     throw InputError(where +
                      ": another crevasse process is writing to this database (the file is "
                      "locked); wait for it to end" +
@@ -305,8 +316,8 @@ Store Store::open_writer(const fs::path& path, double wait_s, const std::string&
       SQLITE_OK) {
     const std::string msg = db ? sqlite3_errmsg(db) : "out of memory";
     sqlite3_close_v2(db);
-    ::close(fd);
     undo();
+    ::close(fd);
     throw InputError(where + ": cannot open the database (" + msg + ")");
   }
   Store store(db, path, fd);
@@ -332,7 +343,7 @@ Store Store::open_writer(const fs::path& path, double wait_s, const std::string&
     if (version != kStoreSchemaVersion) store.transaction([&] {
       if (version == 1) {
         store.exec("ALTER TABLE cases ADD COLUMN under_resolved INTEGER NOT NULL DEFAULT 0");
-        store.exec(std::string("UPDATE cases SET under_resolved = ") + kUnderResolvedSql);
+        store.exec("UPDATE cases SET under_resolved = " + under_resolved_rule_sql());
       }
       store.exec(kSchema);
       store.exec("PRAGMA user_version = " + std::to_string(kStoreSchemaVersion));
@@ -399,6 +410,10 @@ Store Store::open_reader(const fs::path& path) {
 }
 
 int Store::schema_version() const { return read_user_version(db_); }
+
+std::string Store::under_resolved_column() const {
+  return schema_version() >= 2 ? "under_resolved" : under_resolved_rule_sql();
+}
 
 std::optional<std::string> Store::study_hash() {
   Statement s(db_, "SELECT study_hash FROM study WHERE id = 1");

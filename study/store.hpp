@@ -23,10 +23,6 @@ namespace crevasse {
 // 2: cases.under_resolved. A version-1 file is upgraded when a writer opens it and read as it is.
 inline constexpr int kStoreSchemaVersion = 2;
 
-// The SQL of the strength-resolution rule over a cases row (for files written before the column).
-inline constexpr const char* kUnderResolvedSql =
-    "(tensile_strength_pa / (json_extract(scene_json, '$.ice.density') * "
-    "json_extract(scene_json, '$.gravity.g')) < 3.0 * dx_m)";
 
 // One prepared statement. Bind indices start at 1, column indices at 0.
 class Statement {
@@ -120,6 +116,9 @@ class Store {
 
   sqlite3* handle() const { return db_; }
   int schema_version() const;  // PRAGMA user_version
+  // The SQL for a cases row's under_resolved flag: the column, or in a version-1 file the rule
+  // (analysis::strength_under_resolved) evaluated over the row.
+  std::string under_resolved_column() const;
   const std::filesystem::path& path() const { return path_; }
   void exec(const std::string& sql);
   // Runs `body` inside BEGIN IMMEDIATE ... COMMIT; rolls back and rethrows on an exception.

@@ -31,6 +31,8 @@ extern "C" void on_interrupt_signal(int sig) {
 
 struct InterruptHandlers {
   InterruptHandlers() {
+    g_interrupt.store(false);
+    g_signal = 0;
     for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, on_interrupt_signal);
   }
   ~InterruptHandlers() {

@@ -142,6 +142,7 @@ TEST(HostileInputs, TheWriterLockFollowsTheFileNotItsPath) {
   for (const fs::path& other : {dir / "sub" / "a.db", dir / "hard.db", dir / "sub" / ".." / "c.db"})
     EXPECT_THROW(Store::open_writer(other, 0.0), InputError) << other;
   EXPECT_FALSE(fs::exists(dir / "c.db.lock"));
+  EXPECT_TRUE(fs::exists(dir / "c.db")) << "a refused writer removed the holder's new database";
 }
 
 TEST(HostileInputs, ARefusedCommandLeavesTheFileSystemAsItFoundIt) {
