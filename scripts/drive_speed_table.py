@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""Drive-speed table of a study that sweeps /drive/speed (studies/drive_speed_long.json).
+"""Drive-speed table of a study that sweeps /drive/speed (studies/cliff/drive_speed_long.json).
 
-    python3 scripts/drive_speed_table.py results/drive_speed_long.db [--reference 4]
+    python3 scripts/drive_speed_table.py results/cliff/drive_speed_long.db [--reference 4]
 
 Exports the database with `crevasse export` into a temporary directory and prints, per
 (H_i, Pi) pair, one Markdown row per drive speed: the crevasse count, the median spacing and

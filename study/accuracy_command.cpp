@@ -99,7 +99,7 @@ std::vector<fs::path> accuracy_report(const AccuracyCommandOptions& opt, std::st
     if (numerics.size() < 2)
       throw InputError(opt.db_path + ": every finished case has the same numerics (dx, particles "
                        "per cell, CFL, drive speed); accuracy compares runs that differ in them "
-                       "(e.g. studies/accuracy_cost.json)");
+                       "(e.g. studies/accuracy_flowing.json)");
   }
   // Coarsest grid first (the figure's colours and legend follow this order), then case order.
   std::stable_sort(rows.begin(), rows.end(),

@@ -1,13 +1,13 @@
 #pragma once
 // `crevasse accuracy DB --out DIR`: accuracy against cost of a study that varies the numerics
-// (studies/accuracy_cost.json, docs/study_format.md): per case the grid spacing, particles per cell,
+// (studies/accuracy_flowing.json, docs/study_format.md): per case the grid spacing, particles per cell,
 // CFL number, drive speed V_x, steps, particle-steps, wall time and peak memory, the median spacing and depth
 // and their change against a reference case (by default the finest: the most particle-steps
 // among the cases with a spacing). Writes accuracy_cost.csv, accuracy_cost.md (the table) and
 // accuracy_cost.png/.svg (median L_p/H_i with quartile bars against wall time, one marker per
 // grid spacing (and drive speed, where it differs from the reference's); cases without a
 // spacing on the bottom edge). `--add-cases DB` adds the finished cases of other databases as
-// rows labelled `<stem>:<index>` (studies/accuracy_drive.json: the same case at faster drives).
+// rows labelled `<stem>:<index>` (studies/cliff/accuracy_drive.json: the same case at faster drives).
 #include <filesystem>
 #include <optional>
 #include <string>

@@ -143,7 +143,7 @@ int main(int argc, char** argv) {
   predict->add_option("--level", predict_opt.level, "Confidence level (default 0.95)");
 
   crevasse::AccuracyCommandOptions accuracy_opt;
-  auto* accuracy = app.add_subcommand("accuracy", "Accuracy against cost of a study over the numerics (studies/accuracy_cost.json): table and figure");
+  auto* accuracy = app.add_subcommand("accuracy", "Accuracy against cost of a study over the numerics (studies/accuracy_flowing.json): table and figure");
   accuracy->add_option("db", accuracy_opt.db_path, "Study database")->required();
   accuracy->add_option("--out", accuracy_opt.out_dir, "Output directory")->required();
   accuracy->add_option("--add-cases", accuracy_opt.add_dbs, "More databases whose finished cases are added as rows <stem>:<index> (repeatable)");

@@ -1,7 +1,7 @@
 // Measurement on real simulations: at the same H_i, stronger ice (larger Π)
 // breaks into fewer, wider-spaced crevasses than weaker ice. The shipped H_i = 100 m scene
 // (cliff start, S = 1, dx = 10 m, stopped after 4 H_i through the gate) at Π = 0.2 and Π = 1,
-// measured in the gate frame. The cliff-scene quick study (results/cliff_quick.db, engine 0.3.0) gives median
+// measured in the gate frame. The cliff-scene quick study (results/cliff/cliff_quick.db, engine 0.3.0) gives median
 // L_p/H_i = 0.89 at Π = 0.12–0.28 and 1.18 at Π = 1; the test asks for a 10 % difference, a
 // third of the measured one, so that particle-scale changes of the engine do not flip it while
 // a loss of the trend does.

@@ -357,21 +357,32 @@ TEST(Shard, ParsesAndRefuses) {
 namespace crevasse {
 namespace {
 
-// Every study shipped in studies/ loads (named after its file), and quick.json runs the flowing
-// glacier (draped over the whole bed, fed by an inflow, no ice cliff) from weak to strong ice in 2D,
-// with its strongest cases resolved (c/(ρ_i g) ≥ 3 dx).
+// Every study shipped in studies/ loads (named after its file) and runs a glacier in contact with
+// its bed across the whole step (draped to the outflow, no ice cliff); the calving-front studies
+// of studies/cliff/ all start from the cliff. quick.json runs the flowing glacier (fed by an
+// inflow) from weak to strong ice in 2D, with its strongest cases resolved (c/(ρ_i g) ≥ 3 dx).
 TEST(ShippedStudies, AllLoadAndQuickSpansWeakToStrongIce) {
   const std::filesystem::path dir = std::filesystem::path(CREVASSE_SOURCE_DIR) / "studies";
   int loaded = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
-    if (entry.path().extension() != ".json") continue;
-    SCOPED_TRACE(entry.path().string());
-    const Study s = load_study_file(entry.path());
-    EXPECT_EQ(s.name, entry.path().stem().string());
-    EXPECT_FALSE(s.cases.empty());
-    ++loaded;
+  for (const bool cliff : {false, true}) {
+    for (const auto& entry : std::filesystem::directory_iterator(cliff ? dir / "cliff" : dir)) {
+      if (entry.path().extension() != ".json") continue;
+      SCOPED_TRACE(entry.path().string());
+      const Study s = load_study_file(entry.path());
+      EXPECT_EQ(s.name, entry.path().stem().string());
+      EXPECT_FALSE(s.cases.empty());
+      for (const auto& c : s.cases) {
+        if (cliff) {
+          EXPECT_EQ(c.scene.draped_length, 0.0) << c.label;
+        } else {
+          EXPECT_GT(c.scene.draped_length, c.scene.step_length) << c.label;
+          EXPECT_TRUE(c.scene.has(Effect::outflow)) << c.label;
+        }
+      }
+      ++loaded;
+    }
   }
-  EXPECT_GE(loaded, 12);  // the studies of results/README.md
+  EXPECT_GE(loaded, 20);  // the studies of results/README.md
   const Study quick = load_study_file(dir / "quick.json");
   double lo = 1e9, hi = 0;
   std::size_t resolved = 0;
@@ -391,8 +402,8 @@ TEST(ShippedStudies, AllLoadAndQuickSpansWeakToStrongIce) {
   EXPECT_LE(quick.cases.size(), 12u);
   // accuracy_drive's rows are accuracy_cost's cases at other drive speeds: the same scene
   // apart from drive.speed, so the table compares like with like.
-  const Study acc = load_study_file(dir / "accuracy_cost.json");
-  const Study drive = load_study_file(dir / "accuracy_drive.json");
+  const Study acc = load_study_file(dir / "cliff" / "accuracy_cost.json");
+  const Study drive = load_study_file(dir / "cliff" / "accuracy_drive.json");
   for (const auto& c : drive.cases) {
     SCOPED_TRACE(c.label);
     EXPECT_NE(c.scene.drive_speed, 4.0);
@@ -406,8 +417,8 @@ TEST(ShippedStudies, AllLoadAndQuickSpansWeakToStrongIce) {
     EXPECT_EQ(matched, 1);
   }
   // three_d runs at cohesion ratios of cliff_quick's cases (its 2D counterpart on the diagram).
-  const Study cliff_quick = load_study_file(dir / "cliff_quick.json");
-  const Study three = load_study_file(dir / "three_d.json");
+  const Study cliff_quick = load_study_file(dir / "cliff" / "cliff_quick.json");
+  const Study three = load_study_file(dir / "cliff" / "three_d.json");
   for (const auto& c : three.cases) {
     EXPECT_EQ(c.scene.dim, 3);
     bool matched = false;
