@@ -147,6 +147,7 @@ ResolvedMeasureSettings resolve_in_frame(const ParticleSnapshot& snapshot,
   }
 
   require_non_negative(settings.resolution_floor_over_dx, "resolution_floor_over_dx");
+  require_non_negative(settings.min_depth_over_dx, "min_depth_over_dx");
   require_positive(settings.link_distance_over_spacing, "link_distance_over_spacing");
   require_non_negative(settings.surface_reach_over_dx, "surface_reach_over_dx");
   require_non_negative(settings.window_margin_over_h, "window_margin_over_h");
@@ -159,6 +160,7 @@ ResolvedMeasureSettings resolve_in_frame(const ParticleSnapshot& snapshot,
           "fragmented_fraction must lie in (0, 1], got " +
               std::to_string(settings.fragmented_fraction));
   r.resolution_floor_m = settings.resolution_floor_over_dx * r.dx_m;
+  r.min_depth_m = settings.min_depth_over_dx * r.dx_m;
   r.link_distance_m = settings.link_distance_over_spacing * r.particle_spacing_m;
   r.surface_reach_m = settings.surface_reach_over_dx * r.dx_m;
   r.surface_smoothing_bins = settings.surface_smoothing_bins;
@@ -420,6 +422,13 @@ CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
       kept.push_back(c);
     }
   }
+  // Shallower than the depth floor (after merging, so a deep crevasse keeps a shallow
+  // neighbour's width): not a crevasse at this resolution.
+  std::erase_if(kept, [&](const Candidate& c) {
+    const bool shallow = c.crevasse.depth_m < r.min_depth_m;
+    m.shallow_count += shallow;
+    return shallow;
+  });
   for (std::size_t i = 0; i < kept.size(); ++i) {
     if (i + 1 < kept.size()) {
       const double s = kept[i + 1].crevasse.x_m - kept[i].crevasse.x_m;

@@ -40,6 +40,10 @@ struct MeasureSettings {
   // Neighbouring crevasses closer than this are one feature at this resolution: merged, and
   // the spacing between them is dropped and counted (docs/measurement.md).
   double resolution_floor_over_dx = 3.0;
+  // A crevasse shallower than this is not resolved either (a damaged lens one or two particle
+  // rows under the surface cannot be told from an opening at this resolution): not counted,
+  // and counted in shallow_count instead. 0 counts every surface-reaching cluster.
+  double min_depth_over_dx = 3.0;
   // Damaged particles closer than this belong to one crevasse; 1.5 spacings links axial and
   // diagonal lattice neighbours but not particles across a one-particle intact gap.
   double link_distance_over_spacing = 1.5;
@@ -79,6 +83,7 @@ struct ResolvedMeasureSettings {
   double ice_thickness_m = 0.0;
   double particle_spacing_m = 0.0;
   double resolution_floor_m = 0.0;
+  double min_depth_m = 0.0;
   double link_distance_m = 0.0;
   double surface_reach_m = 0.0;
   int surface_smoothing_bins = 0;
@@ -123,6 +128,7 @@ struct CrevasseMeasurement {
   std::vector<Crevasse> crevasses;  // inside the window, sorted by x, after merging
   std::vector<double> spacings_m;   // between consecutive crevasses, all ≥ the floor
   std::size_t dropped_spacing_count = 0;
+  std::size_t shallow_count = 0;  // surface-reaching features shallower than min_depth_m
   std::size_t particle_count = 0;  // particles measured (the band, in 3D)
   std::size_t window_particle_count = 0;
   std::size_t damaged_particle_count = 0;  // of the measured particles

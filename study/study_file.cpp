@@ -251,7 +251,7 @@ analysis::MeasureSettings measure_settings_from_json(const json& j) {
   const ordered_json o = j;
   refuse_unknown_keys(o, "measurement",
                  {"frame", "damage_threshold", "eps_v_p_threshold", "window_min_x_m", "window_max_x_m",
-                  "window_margin_over_h", "resolution_floor_over_dx", "link_distance_over_spacing",
+                  "window_margin_over_h", "resolution_floor_over_dx", "min_depth_over_dx", "link_distance_over_spacing",
                   "surface_reach_over_dx", "surface_smoothing_bins",
                   "surface_bridge_half_width_over_h", "fragmented_fraction", "y_band_width_over_dx",
                   "y_band_center_m", "dx_m", "ice_thickness_m", "particle_spacing_m"});
@@ -277,6 +277,7 @@ analysis::MeasureSettings measure_settings_from_json(const json& j) {
                                            " must exceed window_min_x_m " + fmt(*s.window_min_x_m));
   num("window_margin_over_h", s.window_margin_over_h, {0.0, 100.0, false, false});
   num("resolution_floor_over_dx", s.resolution_floor_over_dx, {0.0, 100.0, false, false});
+  num("min_depth_over_dx", s.min_depth_over_dx, {0.0, 100.0, false, false});
   num("link_distance_over_spacing", s.link_distance_over_spacing, {0.0, 10.0, true, false});
   num("surface_reach_over_dx", s.surface_reach_over_dx, {0.0, 100.0, true, false});
   if (o.contains("surface_smoothing_bins")) {
@@ -307,6 +308,7 @@ json measure_settings_to_json(const analysis::MeasureSettings& s) {
       {"window_max_x_m", opt(s.window_max_x_m)},
       {"window_margin_over_h", s.window_margin_over_h},
       {"resolution_floor_over_dx", s.resolution_floor_over_dx},
+      {"min_depth_over_dx", s.min_depth_over_dx},
       {"link_distance_over_spacing", s.link_distance_over_spacing},
       {"surface_reach_over_dx", s.surface_reach_over_dx},
       {"surface_smoothing_bins", s.surface_smoothing_bins},

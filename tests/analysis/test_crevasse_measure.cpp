@@ -135,6 +135,34 @@ TEST(MeasureBuried, DamageThatDoesNotReachTheSurfaceIsNotACrevasse) {
   EXPECT_NEAR(m.crevasses[0].depth_m, 50.0, spec.dx_m);
 }
 
+// A lens one or two particle rows under an intact surface row (the strong-ice case of the
+// flowing glacier's hand count, docs/measurement.md) and a notch 20 m deep both reach the
+// surface but are shallower than the 3·dx = 30 m depth floor: counted as shallow, not as
+// crevasses; the 50 m notch is measured. With the floor at 0 all three are crevasses.
+TEST(MeasureDepthFloor, FeaturesShallowerThanThreeCellsAreNotCrevasses) {
+  SlabSpec spec;
+  const std::vector<Notch> notches = {
+      {.x_m = 300.0, .depth_m = 15.0, .width_m = 10.0, .top_gap_m = 5.0},
+      {.x_m = 600.0, .depth_m = 20.0},
+      {.x_m = 900.0, .depth_m = 50.0}};
+  const CrevasseMeasurement m = measure_crevasses(make_slab(spec, notches));
+  EXPECT_EQ(m.cluster_count, 3u);
+  EXPECT_EQ(m.shallow_count, 2u);
+  ASSERT_EQ(m.crevasses.size(), 1u);
+  EXPECT_NEAR(m.crevasses[0].x_m, 900.0, spec.dx_m);
+  EXPECT_NEAR(m.crevasses[0].depth_m, 50.0, spacing_of(spec));
+  EXPECT_FALSE(m.flags.has_spacing);
+
+  MeasureSettings all;
+  all.min_depth_over_dx = 0.0;
+  const CrevasseMeasurement every = measure_crevasses(make_slab(spec, notches), all);
+  EXPECT_EQ(every.shallow_count, 0u);
+  ASSERT_EQ(every.crevasses.size(), 3u);
+  EXPECT_NEAR(every.crevasses[0].depth_m, 15.0, spacing_of(spec));
+  EXPECT_NEAR(every.crevasses[1].depth_m, 20.0, spacing_of(spec));
+  EXPECT_EQ(every.spacings_m.size(), 2u);
+}
+
 TEST(MeasureFloor, NotchesCloserThanTheFloorCountAsOne) {
   SlabSpec spec;
   // 20 m < 3·dx = 30 m apart: one feature at this resolution, keeping the deeper one.
@@ -209,7 +237,10 @@ TEST(MeasureSlope, DepthIsRelativeToTheLocalSurfaceOnASlope) {
   SlabSpec spec{.x_max_m = 2000.0, .noise_over_spacing = 0.2};
   spec.base_z = [](double x) { return -0.1 * x; };
   const auto notches = notch_train(spec, 80.0, {30.0, 60.0});
-  const CrevasseMeasurement m = measure_crevasses(make_slab(spec, notches));
+  // Notches at the 3-cell depth floor: the floor is off, this test is about the surface.
+  MeasureSettings no_floor;
+  no_floor.min_depth_over_dx = 0.0;
+  const CrevasseMeasurement m = measure_crevasses(make_slab(spec, notches), no_floor);
   // One cell: lattice placement and noise; on a slope a dx-bin also spans 1 m of height.
   expect_matches(m, notches, spec.dx_m);
   expect_measurement_finite(m);
@@ -221,7 +252,10 @@ TEST(MeasureCurved, DepthIsRelativeToTheLocalSurfaceOnACurvedSurface) {
   SlabSpec spec{.thickness_m = 150.0, .x_max_m = 2500.0, .noise_over_spacing = 0.2};
   spec.base_z = [](double x) { return -40.0 * std::tanh((x - 1200.0) / 200.0); };
   const auto notches = notch_train(spec, 60.0, {40.0, 75.0, 20.0});
-  const CrevasseMeasurement m = measure_crevasses(make_slab(spec, notches));
+  // Notches below the 3-cell depth floor: the floor is off, this test is about the surface.
+  MeasureSettings no_floor;
+  no_floor.min_depth_over_dx = 0.0;
+  const CrevasseMeasurement m = measure_crevasses(make_slab(spec, notches), no_floor);
   // One cell, as above; the bridge and the lips add < 1 m on these curvatures.
   expect_matches(m, notches, spec.dx_m);
   expect_measurement_finite(m);
