@@ -55,6 +55,18 @@ int run(const crevasse::SceneConfig& scene, long steps) {
   for (double e : P.eps_v_p) damaged += e > 0.0;
   std::printf("particles %zu, steps %lld, t = %.6f s, damaged %ld\nall      %016llx\n", P.size(),
               static_cast<long long>(sim.steps()), t, damaged, static_cast<unsigned long long>(all));
+  // What the state arrays do not hold: the gate's records (archive included, through the
+  // snapshot) and the read-outs, so that moving those parts of the engine is checked too.
+  const crevasse::ParticleSnapshot snap = sim.snapshot();
+  std::uint64_t gate = hash_array(snap.gate_x_ref);
+  gate = fnv1a(snap.gate_z_ref.data(), snap.gate_z_ref.size() * sizeof(double), gate);
+  gate = fnv1a(snap.gate_eps_v_p.data(), snap.gate_eps_v_p.size() * sizeof(double), gate);
+  const double reads[] = {snap.gate_passed_length_m, sim.removed_mass(), sim.inflow_mass(),
+                          sim.total_mass(), sim.kinetic_energy(), sim.gravitational_potential_energy(),
+                          sim.cap_dissipated_energy(), sim.max_yield_violation(), sim.front_x(),
+                          sim.ice_front_x(), sim.max_speed(), sim.last_dt()};
+  std::printf("gate     %016llx (%zu records)\nreadouts %016llx\n", static_cast<unsigned long long>(gate),
+              snap.gate_eps_v_p.size(), static_cast<unsigned long long>(fnv1a(reads, sizeof reads)));
   return 0;
 }
 
