@@ -10,6 +10,35 @@
 #include <string>
 #include <vector>
 
+#include "engine/gate_recorder.hpp"
+#include "engine/particles.hpp"
+#include "engine/scene.hpp"
+
+namespace crevasse {
+
+// The run's scalar state that a checkpoint carries besides the particles and the gate.
+struct RunCounters {
+  double time = 0.0, dt = 0.0;
+  std::int64_t steps = 0, particle_steps = 0, return_map_evaluations = 0;
+  double removed_mass = 0.0, front_x = 0.0, max_speed = 0.0;
+  bool settled = false;
+  double inflow_mass = 0.0;
+  std::int64_t inflow_columns = 0;
+};
+
+// Written atomically (temporary file, then rename); SimulationError when it cannot be.
+template <int Dim>
+void save_checkpoint(const std::string& path, const SceneConfig& scene, const RunCounters& run,
+                     const Particles<Dim>& particles, const GateRecorder<Dim>& gate);
+// Throws SimulationError when the file is not a checkpoint of this scene, dimension and engine
+// version, is truncated, or its arrays disagree with what `particles` holds (plastic state,
+// piston layer, gate records); run, particles and gate change only when the whole file is good.
+template <int Dim>
+void load_checkpoint(const std::string& path, const SceneConfig& scene, RunCounters& run,
+                     Particles<Dim>& particles, GateRecorder<Dim>& gate);
+
+}  // namespace crevasse
+
 namespace crevasse::checkpoint {
 
 inline constexpr char kMagic[8] = {'C', 'R', 'V', 'C', 'K', 'P', 'T', '1'};

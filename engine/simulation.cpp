@@ -7,17 +7,16 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <cmath>
 #include <numbers>
-#include <random>
 #include <sstream>
 
 #include "engine/bspline.hpp"
 #include "engine/checkpoint.hpp"
 #include "engine/error.hpp"
 #include "engine/fast_math.hpp"
+#include "engine/grid_boundaries.hpp"
+#include "engine/seeding.hpp"
 
 namespace crevasse {
 namespace {
@@ -29,13 +28,6 @@ constexpr int kSlabCells = 4;
 // costs ~17% (docs/performance.md).
 constexpr int kSortInterval = 100;
 constexpr std::size_t kGrain = 1024;
-
-template <int Dim>
-Vec<Dim> to_vec(const std::array<double, 3>& a) {
-  Vec<Dim> v;
-  for (int i = 0; i < Dim; ++i) v[i] = a[i];
-  return v;
-}
 
 std::string describe_position(const double* x, int dim) {
   std::ostringstream o;
@@ -68,9 +60,9 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   } else if (scene_.bed_shape == "flat") {
     bed_ = Bed::flat(scene_.flat_bed_z, x_lo, x_hi);
   }
-  if (bed_) build_bed_table();
-  seed_particles();
-  if (scene_.records_gate()) init_gate();
+  if (bed_) bed_field_ = BedField<Dim>(*bed_, domain_lo_, domain_hi_, scene_.dx);
+  particles_ = seed_ice<Dim>(scene_, moduli_, bed_ ? &*bed_ : nullptr);
+  if (scene_.records_gate()) gate_ = GateRecorder<Dim>(particles_, scene_.gate_x());
   if (scene_.body == "slab" && scene_.has(Effect::gravity)) {
     // No particle of a slab can go faster than free fall from the top of the ice to the floor
     // plus twice the drive (a block pushed off at V_x and rebounding); 1.5× that is a margin
@@ -92,24 +84,38 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   add_stage(g != 0.0 ? "grid_velocity_gravity" : "grid_velocity",
             [this, gravity] { grid_velocity(gravity); });
   const bool has_inflow = scene_.drive_boundary == "inflow";
-  if (scene_.has(Effect::drive) && !has_inflow) add_stage("drive_grid", [this] { drive_grid_nodes(); });
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  if (scene_.has(Effect::drive) && !has_inflow) {
+    add_stage("drive_grid", [this] { pull_nodes_with_piston(grid_, particles_, drive_speed_now(), drive_node_mass_); });
+  }
   if (scene_.has(Effect::basal_friction))
-    add_stage("basal_friction", [this] { apply_bed_friction_to_grid(); });
-  if (has_inflow) add_stage("inflow_grid", [this] { drive_inflow_nodes(); });
-  if (scene_.has(Effect::downstream_drive))
-    add_stage("downstream_drive", [this] { drive_downstream_nodes(); });
-  if (scene_.has(Effect::lateral_walls)) {
-    add_stage("lateral_walls", [this] {
-      apply_walls_to_grid({1}, domain_lo_, domain_hi_);
+    add_stage("basal_friction", [this] { apply_bed_friction(grid_, bed_field_, scene_.bed_friction); });
+  if (has_inflow) {
+    // The nodes up to kInflowHoldCells from the back move at V(t) along x, free vertically.
+    // Every particle within 2.5 cells of the back has its whole stencil on them, so it moves at
+    // exactly V(t) and its F_E sees the same velocity field as its position does; the ice ahead
+    // is pushed through the grid, and its compression is stress.
+    add_stage("inflow_grid", [this] {
+      hold_nodes_at_speed(grid_, -kInfinity, kInflowHoldCells * scene_.dx, drive_speed_now(), false);
     });
+  }
+  if (scene_.has(Effect::downstream_drive)) {
+    // The glacier goes on past the domain: the nodes of the last cells before the outflow line
+    // move with it, at (V(t), 0) on the flat floor. Without this the floor ice is free to be
+    // pushed away by the ice on the ramp, which at μ_b = 0.1 is not held by friction alone
+    // (ρ g H_i (H_s − μ_b L_s) down the ramp against μ_b ρ g H_i L_floor on the floor).
+    add_stage("downstream_drive", [this] {
+      hold_nodes_at_speed(grid_, domain_hi_[0] - kDownstreamDriveCells * scene_.dx, kInfinity, drive_speed_now(), true);
+    });
+  }
+  if (scene_.has(Effect::lateral_walls)) {
+    add_stage("lateral_walls", [this] { apply_free_slip_walls(grid_, {1}, domain_lo_, domain_hi_); });
   }
   if (scene_.has(Effect::box_walls)) {
-    add_stage("box_walls", [this] {
-      apply_walls_to_grid(scene_.wall_axes, domain_lo_, domain_hi_);
-    });
+    add_stage("box_walls", [this] { apply_free_slip_walls(grid_, scene_.wall_axes, domain_lo_, domain_hi_); });
   }
   if (scene_.has(Effect::velocity_boundaries))
-    add_stage("velocity_boundaries", [this] { apply_velocity_boxes_to_grid(); });
+    add_stage("velocity_boundaries", [this] { apply_velocity_boxes(grid_, scene_.velocity_boxes, time_); });
   if (scene_.settle_time > 0.0) {
     // Damping exists only while settling: one branch per step, none per particle.
     settle_damping_rate_ = scene_.p_wave_speed() /
@@ -148,7 +154,7 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   if (tail_effects_.drive) particle_effects_.push_back("drive");
   // Particles never leave the domain: the last line of defence, whatever the effects.
   particle_effects_.push_back("domain_clamp");
-  if (scene_.records_gate()) add_stage("gate", [this] { record_gate(); });
+  if (scene_.records_gate()) add_stage("gate", [this] { gate_.record(particles_); });
   if (scene_.has(Effect::outflow)) add_stage("outflow", [this] { remove_outflow(); });
   if (has_inflow) add_stage("inflow", [this] { inflow(); });
   add_stage("time_step", [this] { update_time_step(); });
@@ -161,194 +167,6 @@ template <int Dim>
 void Simulation<Dim>::add_stage(std::string name, std::function<void()> run) {
   stages_.push_back({name, 0, 0.0});
   stage_fns_.push_back({std::move(name), std::move(run)});
-}
-
-template <int Dim>
-void Simulation<Dim>::build_bed_table() {
-  const int x_axis = 0, z_axis = up_axis<Dim>;
-  const double dx = scene_.dx;
-  bed_i0_ = static_cast<int>(std::floor(domain_lo_[x_axis] / dx)) - 3;
-  bed_k0_ = static_cast<int>(std::floor(domain_lo_[z_axis] / dx)) - 3;
-  bed_ni_ = static_cast<int>(std::ceil(domain_hi_[x_axis] / dx)) + 4 - bed_i0_;
-  // Rows up to 4 cells above the highest point of the bed, not up to the top of the domain:
-  // above that row the signed distance is at least 4·dx, so no node there touches the bed
-  // (friction skips nodes outside the table) and the clamped interpolation for a particle
-  // above it stays positive (no projection), exactly as with the full table. For a glacier the
-  // full table was the largest per-domain array (≈ 60 B per particle at H_i = 300 m).
-  double bed_top = -std::numeric_limits<double>::infinity();
-  for (const auto& v : bed_->vertices()) bed_top = std::max(bed_top, v[1]);
-  const int full_nk = static_cast<int>(std::ceil(domain_hi_[z_axis] / dx)) + 4 - bed_k0_;
-  const int bed_nk = static_cast<int>(std::ceil(bed_top / dx)) + 5 - bed_k0_;
-  bed_nk_ = std::max(2, std::min(full_nk, bed_nk));
-  bed_phi_.resize(static_cast<std::size_t>(bed_ni_) * bed_nk_);
-  bed_normal_.resize(bed_phi_.size());
-  tbb::parallel_for(0, bed_ni_, [&](int i) {
-    for (int k = 0; k < bed_nk_; ++k) {
-      const double x = (bed_i0_ + i) * dx, z = (bed_k0_ + k) * dx;
-      const std::size_t f = static_cast<std::size_t>(i) * bed_nk_ + k;
-      bed_phi_[f] = bed_->signed_distance(x, z);
-      bed_normal_[f] = bed_->normal(x, z);
-    }
-  });
-  // Per column of cells, the lowest cell row from which every cell up to the table's top has
-  // four corners with φ ≥ 0 (bed_nk_ − 1 when the top cell has not).
-  bed_clear_k_.assign(static_cast<std::size_t>(bed_ni_ - 1), bed_nk_ - 1);
-  const auto at = [&](int i, int k) { return bed_phi_[static_cast<std::size_t>(i) * bed_nk_ + k]; };
-  for (int i = 0; i + 1 < bed_ni_; ++i) {
-    for (int k = bed_nk_ - 2; k >= 0; --k) {
-      if (!(at(i, k) >= 0.0 && at(i, k + 1) >= 0.0 && at(i + 1, k) >= 0.0 && at(i + 1, k + 1) >= 0.0))
-        break;
-      bed_clear_k_[static_cast<std::size_t>(i)] = k;
-    }
-  }
-  // The same as a height, safe for the column found from x·(1/dx) instead of x/dx (the two
-  // may round to neighbouring columns): the highest clear row of this and the two neighbouring
-  // columns, one cell higher still; never, when one of them has no clear cell at all (the
-  // clamp to the table's top row would then land in a cell that is not clear).
-  bed_inv_dx_ = 1.0 / dx;
-  bed_clear_z_.assign(bed_clear_k_.size(), std::numeric_limits<double>::infinity());
-  for (int i = 0; i + 1 < bed_ni_; ++i) {
-    int k = 0;
-    for (int j = std::max(0, i - 1); j <= std::min(bed_ni_ - 2, i + 1); ++j)
-      k = std::max(k, bed_clear_k_[static_cast<std::size_t>(j)]);
-    if (k <= bed_nk_ - 2) bed_clear_z_[static_cast<std::size_t>(i)] = (bed_k0_ + k + 2) * dx;
-  }
-}
-
-template <int Dim>
-typename Simulation<Dim>::BedCell Simulation<Dim>::bed_cell(const Vec<Dim>& x) const {
-  // The table cell of x and x's place in it, clamped to the table.
-  const double dx = scene_.dx;
-  const double gx = x[0] / dx - bed_i0_, gz = x[up_axis<Dim>] / dx - bed_k0_;
-  BedCell c;
-  c.i = std::clamp(floor_to_int(gx), 0, bed_ni_ - 2);
-  c.k = std::clamp(floor_to_int(gz), 0, bed_nk_ - 2);
-  c.fx = std::clamp(gx - c.i, 0.0, 1.0);
-  c.fz = std::clamp(gz - c.k, 0.0, 1.0);
-  return c;
-}
-
-template <int Dim>
-double Simulation<Dim>::bed_phi(const Vec<Dim>& x, Vec<Dim>* normal) const {
-  return bed_phi(bed_cell(x), normal);
-}
-
-template <int Dim>
-double Simulation<Dim>::bed_phi(const BedCell& cell, Vec<Dim>* normal) const {
-  // Bilinear interpolation of the node table in (x, z).
-  const int i = cell.i, k = cell.k;
-  const double fx = cell.fx, fz = cell.fz;
-  const double w[4] = {(1 - fx) * (1 - fz), (1 - fx) * fz, fx * (1 - fz), fx * fz};
-  const std::size_t f[4] = {static_cast<std::size_t>(i) * bed_nk_ + k,
-                            static_cast<std::size_t>(i) * bed_nk_ + k + 1,
-                            static_cast<std::size_t>(i + 1) * bed_nk_ + k,
-                            static_cast<std::size_t>(i + 1) * bed_nk_ + k + 1};
-  double phi = 0.0;
-  for (int c = 0; c < 4; ++c) phi += w[c] * bed_phi_[f[c]];
-  if (normal) {
-    double nx = 0.0, nz = 0.0;
-    for (int c = 0; c < 4; ++c) {
-      nx += w[c] * bed_normal_[f[c]][0];
-      nz += w[c] * bed_normal_[f[c]][1];
-    }
-    normal->setZero();
-    const double len = std::hypot(nx, nz);
-    (*normal)[0] = len > 0 ? nx / len : 0.0;
-    (*normal)[up_axis<Dim>] = len > 0 ? nz / len : 1.0;
-  }
-  return phi;
-}
-
-template <int Dim>
-void Simulation<Dim>::seed_particles() {
-  const double dx = scene_.dx;
-  const int ppc = scene_.particles_per_cell_axis;
-  const double h = dx / ppc;  // particle spacing
-  const double rho = scene_.density;
-  Vec<Dim> lo, hi;
-  double surface_z;
-  // Draped ice: the slab continues past the top of the step between the bed and z_b + H_i.
-  const bool draped = scene_.body == "slab" && scene_.draped_length > 0.0 && bed_.has_value();
-  if (scene_.body == "slab") {
-    lo.setZero();
-    hi.setZero();
-    lo[0] = 0.0;
-    hi[0] = scene_.upstream_length + (draped ? scene_.draped_length : 0.0);
-    lo[up_axis<Dim>] = draped ? 0.0 : scene_.step_height;
-    hi[up_axis<Dim>] = scene_.step_height + scene_.ice_thickness;
-    if constexpr (Dim == 3) {
-      lo[1] = 0.0;
-      hi[1] = scene_.width;
-    }
-  } else {
-    lo = to_vec<Dim>(scene_.box_min);
-    hi = to_vec<Dim>(scene_.box_max);
-  }
-  surface_z = hi[up_axis<Dim>];
-
-  IVec<Dim> count;
-  for (int a = 0; a < Dim; ++a) count[a] = std::max(1, static_cast<int>(std::round((hi[a] - lo[a]) / h)));
-  std::mt19937_64 rng(scene_.seed);
-  std::uniform_real_distribution<double> jitter(-scene_.jitter * h, scene_.jitter * h);
-
-  // Geostatic initial stress (docs/model.md): σ_zz = −ρ g (s − z), lateral stresses
-  // K0·σ_zz with K0 = ν/(1 − ν), the uniaxial-strain state of a laterally confined slab. It is
-  // loaded into F_E through the inverse Hencky law with τ = J σ (two fixed-point passes: J − 1
-  // is of order 1e-3, so the second pass already changes τ by ~1e-6 relative).
-  // "hydrostatic" (K0 = 1) is the cryostatic state of ice that has flowed long enough for its
-  // deviatoric stress to relax: no shear stress at rest, so a low q_y does not yield at t = 0.
-  const bool prestressed = scene_.initial_stress != "none" && scene_.has(Effect::gravity);
-  const double g_vertical = scene_.gravity * std::cos(scene_.gravity_tilt_deg * std::numbers::pi / 180.0);
-  const double k0 = scene_.initial_stress == "hydrostatic"
-                        ? 1.0
-                        : scene_.poisson_ratio / (1.0 - scene_.poisson_ratio);
-  const double cell_volume = std::pow(h, Dim);
-
-  std::size_t total = 1;
-  for (int a = 0; a < Dim; ++a) total *= static_cast<std::size_t>(count[a]);
-  particles_.x.reserve(draped ? total / 2 : total);
-  IVec<Dim> idx = IVec<Dim>::Zero();
-  for (std::size_t n = 0; n < total; ++n) {
-    std::size_t r = n;
-    for (int a = Dim - 1; a >= 0; --a) {
-      idx[a] = static_cast<int>(r % count[a]);
-      r /= count[a];
-    }
-    Vec<Dim> pos;
-    for (int a = 0; a < Dim; ++a) pos[a] = lo[a] + (idx[a] + 0.5) * h + jitter(rng);
-    if (draped) {
-      // Keep the lattice points between the bed and the surface, judged at the unjittered
-      // lattice position so jitter does not change the particle count.
-      const double xl = lo[0] + (idx[0] + 0.5) * h, zl = lo[up_axis<Dim>] + (idx[up_axis<Dim>] + 0.5) * h;
-      const double zb = bed_->height_at(xl);
-      if (zl < zb || zl > zb + scene_.ice_thickness) continue;
-      surface_z = zb + scene_.ice_thickness;
-    }
-    Mat<Dim> fe = Mat<Dim>::Identity();
-    Mat<Dim> tau = Mat<Dim>::Zero();
-    double vol0 = cell_volume;
-    if (prestressed) {
-      Vec<Dim> sigma = Vec<Dim>::Constant(-k0 * rho * g_vertical * (surface_z - pos[up_axis<Dim>]));
-      sigma[up_axis<Dim>] = -rho * g_vertical * (surface_z - pos[up_axis<Dim>]);
-      Vec<Dim> tau_p = sigma;
-      Vec<Dim> eps = Vec<Dim>::Zero();
-      for (int pass = 0; pass < 2; ++pass) {
-        eps = hencky_strain_from_kirchhoff<Dim>(moduli_, tau_p);
-        tau_p = sigma * std::exp(eps.sum());
-      }
-      fe = eps.array().exp().matrix().asDiagonal();
-      tau = principal_kirchhoff<Dim>(moduli_, eps).asDiagonal();
-      vol0 = cell_volume / std::exp(eps.sum());  // the lattice volume is the compressed one
-    }
-    particles_.push_back(pos, rho * cell_volume, vol0, fe, tau);
-  }
-  particles_.shrink_to_fit();
-  if (scene_.has(Effect::plasticity)) particles_.eps_v_p.assign(particles_.size(), 0.0);
-  if (scene_.has(Effect::drive) && scene_.drive_boundary == "piston") {
-    particles_.drive_x0.assign(particles_.size(), std::numeric_limits<double>::quiet_NaN());
-    for (std::size_t p = 0; p < particles_.size(); ++p)
-      if (particles_.x[p][0] < lo[0] + dx) particles_.drive_x0[p] = particles_.x[p][0];
-  }
 }
 
 template <int Dim>
@@ -555,125 +373,6 @@ void Simulation<Dim>::grid_velocity(const Vec<Dim>& gravity) {
 }
 
 template <int Dim>
-void Simulation<Dim>::drive_grid_nodes() {
-  // The piston acts on the grid too: each node's x-velocity is pulled towards the drive speed
-  // in proportion to the share of its mass that comes from the driven layer,
-  // v_x ← v_x + f (V − v_x), f = m_layer/m_node. Without it the layer, moved kinematically,
-  // overran the ice in front of it (the ice there moved at the grid's mass-averaged speed,
-  // ~0.94 vs 1.17 m/s at t = 15 s) and tore a full-depth crack a few cells ahead of the piston.
-  // The share varies smoothly as the layer moves, so no node switches on abruptly.
-  auto& P = particles_;
-  const double v = settling_ ? 0.0 : scene_.drive_velocity(time_);
-  const double inv_dx = 1.0 / scene_.dx;
-  drive_node_mass_.assign(grid_.node_count(), 0.0);
-  for (std::size_t p = 0; p < P.size(); ++p) {
-    if (std::isnan(P.drive_x0[p])) continue;
-    const StencilWeights<Dim> w(P.x[p] * inv_dx);
-    const IVec<Dim> base = w.base();
-    for_each_stencil_node<Dim>(w, [&](const IVec<Dim>& off, double wt) {
-      drive_node_mass_[grid_.flat(base + off)] += wt * P.mass[p];
-    });
-  }
-  for (std::size_t f = 0; f < drive_node_mass_.size(); ++f) {
-    if (drive_node_mass_[f] <= 0.0 || grid_.nodes[f].mass <= 0.0) continue;
-    const double share = std::min(1.0, drive_node_mass_[f] / grid_.nodes[f].mass);
-    grid_.nodes[f].vel[0] += share * (v - grid_.nodes[f].vel[0]);
-  }
-}
-
-template <int Dim>
-void Simulation<Dim>::drive_downstream_nodes() {
-  // The glacier goes on past the domain: the nodes of the last cells before the outflow line
-  // move with it, at (V(t), 0) on the flat floor. Without this the floor ice is free to be
-  // pushed away by the ice on the ramp, which at μ_b = 0.1 is not held by friction alone
-  // (ρ g H_i (H_s − μ_b L_s) down the ramp against μ_b ρ g H_i L_floor on the floor).
-  hold_nodes_at_drive_speed(domain_hi_[0] - kDownstreamDriveCells * scene_.dx,
-                            std::numeric_limits<double>::infinity(), true);
-}
-
-template <int Dim>
-void Simulation<Dim>::drive_inflow_nodes() {
-  // The inflow: the nodes up to kInflowHoldCells from the back move at V(t) along x, free
-  // vertically. Every particle within 2.5 cells of the back has its whole stencil on them, so it
-  // moves at exactly V(t) and its F_E sees the same velocity field as its position does; the
-  // ice ahead is pushed through the grid, and its compression is stress.
-  hold_nodes_at_drive_speed(-std::numeric_limits<double>::infinity(), kInflowHoldCells * scene_.dx, false);
-}
-
-template <int Dim>
-void Simulation<Dim>::hold_nodes_at_drive_speed(double x_lo, double x_hi, bool hold_vertical) {
-  const double v = settling_ ? 0.0 : scene_.drive_velocity(time_);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid_.node_count(), kGrain), [&](const auto& r) {
-    for (std::size_t f = r.begin(); f != r.end(); ++f) {
-      if (grid_.nodes[f].mass <= 0.0) continue;
-      const double x = grid_.position(grid_.node_of(f))[0];
-      if (x < x_lo || x > x_hi) continue;
-      if (hold_vertical) grid_.nodes[f].vel.setZero();
-      grid_.nodes[f].vel[0] = v;
-    }
-  });
-}
-
-template <int Dim>
-void Simulation<Dim>::apply_bed_friction_to_grid() {
-  // Coulomb contact with the static bed on nodes inside or on it: remove the approaching normal
-  // velocity v_n < 0 and reduce the tangential velocity by μ|v_n| (stick if it would reverse).
-  // Separating nodes (v_n ≥ 0) are free, so ice may lift off the bed.
-  const double mu = scene_.bed_friction;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid_.node_count(), kGrain), [&](const auto& r) {
-    for (std::size_t f = r.begin(); f != r.end(); ++f) {
-      if (grid_.nodes[f].mass <= 0.0) continue;
-      const IVec<Dim> node = grid_.node_of(f);
-      const int i = node[0] - bed_i0_, k = node[up_axis<Dim>] - bed_k0_;
-      if (i < 0 || k < 0 || i >= bed_ni_ || k >= bed_nk_) continue;
-      const std::size_t t = static_cast<std::size_t>(i) * bed_nk_ + k;
-      // Nodes on the bed surface have φ = 0 up to round-off in the distance computation.
-      if (bed_phi_[t] > 1e-6 * grid_.dx) continue;
-      Vec<Dim> n = Vec<Dim>::Zero();
-      n[0] = bed_normal_[t][0];
-      n[up_axis<Dim>] = bed_normal_[t][1];
-      Vec<Dim>& v = grid_.nodes[f].vel;
-      const double vn = v.dot(n);
-      if (vn >= 0.0) continue;
-      Vec<Dim> vt = v - vn * n;
-      const double vt_norm = vt.norm();
-      if (vt_norm <= -mu * vn) vt.setZero();
-      else vt *= 1.0 + mu * vn / vt_norm;
-      v = vt;
-    }
-  });
-}
-
-template <int Dim>
-void Simulation<Dim>::apply_walls_to_grid(const std::vector<int>& axes, const Vec<Dim>& lo,
-                                          const Vec<Dim>& hi) {
-  // Free slip: on nodes at or beyond a wall the velocity into the wall is removed.
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid_.node_count(), kGrain), [&](const auto& r) {
-    for (std::size_t f = r.begin(); f != r.end(); ++f) {
-      if (grid_.nodes[f].mass <= 0.0) continue;
-      const Vec<Dim> xn = grid_.position(grid_.node_of(f));
-      for (int a : axes) {
-        if (xn[a] <= lo[a] + 1e-9 * grid_.dx) grid_.nodes[f].vel[a] = std::max(grid_.nodes[f].vel[a], 0.0);
-        if (xn[a] >= hi[a] - 1e-9 * grid_.dx) grid_.nodes[f].vel[a] = std::min(grid_.nodes[f].vel[a], 0.0);
-      }
-    }
-  });
-}
-
-template <int Dim>
-void Simulation<Dim>::apply_velocity_boxes_to_grid() {
-  for (const auto& b : scene_.velocity_boxes) {
-    const Vec<Dim> v = to_vec<Dim>(b.velocity);
-    const Vec<Dim> lo = to_vec<Dim>(b.min) + v * time_, hi = to_vec<Dim>(b.max) + v * time_;
-    for (std::size_t f = 0; f < grid_.node_count(); ++f) {
-      if (grid_.nodes[f].mass <= 0.0) continue;
-      const Vec<Dim> xn = grid_.position(grid_.node_of(f));
-      if ((xn.array() >= lo.array()).all() && (xn.array() <= hi.array()).all()) grid_.nodes[f].vel = v;
-    }
-  }
-}
-
-template <int Dim>
 [[gnu::always_inline]] inline void Simulation<Dim>::gather_velocity(std::size_t p, const StencilWeights<Dim>& w,
                                                                     const StencilOffsets<Dim>& d, std::size_t f0,
                                                                     double c_scale) {
@@ -747,7 +446,7 @@ template <int Dim>
 [[gnu::always_inline]] inline void Simulation<Dim>::finish_particle(std::size_t p, const ParticleTail& tail,
                                                                     StepSummary& acc) {
   auto& P = particles_;
-  if (tail.bed) project_out_of_bed(p);
+  if (tail.bed) bed_field_.project_out(P.x[p]);
   if (tail.drive && !std::isnan(P.drive_x0[p])) {
     // The piston is the back layer of ice (one cell thick), moved kinematically along x at the
     // drive speed and free to slide vertically. A grid-node wall instead gives the ice an
@@ -1022,25 +721,6 @@ void Simulation<Dim>::finish_step() {
 }
 
 template <int Dim>
-[[gnu::always_inline]] inline void Simulation<Dim>::project_out_of_bed(std::size_t p) {
-  auto& x = particles_.x[p];
-  // First a test without divisions: above bed_clear_z_ of its column (rounded either way) a
-  // particle's exact cell is clear (below).
-  const int column = std::clamp(floor_to_int(x[0] * bed_inv_dx_) - bed_i0_, 0, bed_ni_ - 2);
-  if (x[up_axis<Dim>] >= bed_clear_z_[static_cast<std::size_t>(column)]) return;
-  const BedCell cell = bed_cell(x);
-  // A cell whose four corners have φ ≥ 0 interpolates φ ≥ 0 (non-negative weights): nothing to
-  // do, and nothing to interpolate, for most of the ice.
-  if (cell.k >= bed_clear_k_[static_cast<std::size_t>(cell.i)]) return;
-  // The normal (two more interpolations and a hypot) only for the few particles inside.
-  const double phi = bed_phi(cell, nullptr);
-  if (phi >= 0.0) return;
-  Vec<Dim> n;
-  bed_phi(cell, &n);
-  x -= phi * n;
-}
-
-template <int Dim>
 void Simulation<Dim>::remove_outflow() {
   // Ice within three cells of the downstream end has left the scene (docs/model.md).
   const double x_out = domain_hi_[0] - 3.0 * scene_.dx;
@@ -1056,13 +736,7 @@ void Simulation<Dim>::remove_outflow() {
   if (!any) return;
   std::vector<char> keep(P.size());
   for (std::size_t p = 0; p < P.size(); ++p) keep[p] = P.x[p][0] < x_out;
-  if (records_gate()) {
-    for (std::size_t p = 0; p < P.size(); ++p) {
-      if (keep[p] || P.gate_eps[p] < 0.0f) continue;
-      gate_archive_x_.push_back(P.x_ref[p]);
-      gate_archive_eps_.push_back(P.gate_eps[p]);
-    }
-  }
+  if (records_gate()) gate_.archive_removed(P, keep);
   removed_mass_ += P.compact(keep);
   summary_step_ = -1;  // the update's summary counted the removed particles
 }
@@ -1092,55 +766,11 @@ void Simulation<Dim>::inflow() {
       P.v.back() = P.v[q];
       P.C.back() = P.C[q];
       if (P.has_plastic_state()) P.eps_v_p.push_back(0.0);
-      if (records_gate()) {
-        // The gate frame's "initial position": where this ice would have been at t = 0 had the
-        // slab reached that far upstream, so the recorded field stays one continuous glacier.
-        std::array<float, Dim> ref;
-        for (int a = 0; a < Dim; ++a) ref[a] = static_cast<float>(pos[a]);
-        ref[0] = static_cast<float>(pos[0] - s);
-        P.x_ref.push_back(ref);
-        P.gate_eps.push_back(kGateNotYet);
-      }
+      if (records_gate()) GateRecorder<Dim>::add_entering(P, pos, s);
       inflow_mass_ += P.mass[q];
     }
     summary_step_ = -1;  // the update's summary did not see the new ice
   }
-}
-
-template <int Dim>
-void Simulation<Dim>::init_gate() {
-  // Ice that starts past the gate (a draped glacier) never passes it: it is marked so, and
-  // only ice that crosses the gate is recorded and counted in the passed length.
-  auto& P = particles_;
-  const double gx = scene_.gate_x();
-  P.x_ref.resize(P.size());
-  P.gate_eps.assign(P.size(), kGateNotYet);
-  double upstream_volume = 0.0;
-  for (std::size_t p = 0; p < P.size(); ++p) {
-    for (int a = 0; a < Dim; ++a) P.x_ref[p][a] = static_cast<float>(P.x[p][a]);
-    if (P.x[p][0] < gx) upstream_volume += P.vol0[p];
-    else P.gate_eps[p] = kGateNever;
-  }
-  // Every column of ice upstream of the gate is H_i high (on the plateau and, draped, on the
-  // ramp), and the ice starts at x = 0.
-  gate_cross_section_ = upstream_volume > 0.0 ? upstream_volume / gx : 1.0;
-}
-
-template <int Dim>
-void Simulation<Dim>::record_gate() {
-  // Serial: one compare per particle, a few µs per step against milliseconds for the step.
-  auto& P = particles_;
-  const double gx = scene_.gate_x();
-  for (std::size_t p = 0; p < P.size(); ++p) {
-    if (P.gate_eps[p] != kGateNotYet || P.x[p][0] < gx) continue;
-    P.gate_eps[p] = static_cast<float>(P.eps_v_p[p]);
-    gate_passed_volume_ += P.vol0[p];
-  }
-}
-
-template <int Dim>
-double Simulation<Dim>::gate_passed_length() const {
-  return records_gate() ? gate_passed_volume_ / gate_cross_section_ : 0.0;
 }
 
 template <int Dim>
@@ -1232,225 +862,21 @@ void Simulation<Dim>::update_time_step() {
 }
 
 template <int Dim>
-double Simulation<Dim>::total_mass() const {
-  double m = 0.0;
-  for (double v : particles_.mass) m += v;
-  return m;
-}
-
-template <int Dim>
-Vec<Dim> Simulation<Dim>::total_momentum() const {
-  Vec<Dim> s = Vec<Dim>::Zero();
-  for (std::size_t p = 0; p < particles_.size(); ++p) s += particles_.mass[p] * particles_.v[p];
-  return s;
-}
-
-template <int Dim>
-double Simulation<Dim>::kinetic_energy() const {
-  double e = 0.0;
-  for (std::size_t p = 0; p < particles_.size(); ++p)
-    e += 0.5 * particles_.mass[p] * particles_.v[p].squaredNorm();
-  return e;
-}
-
-template <int Dim>
-double Simulation<Dim>::gravitational_potential_energy() const {
-  double e = 0.0;
-  for (std::size_t p = 0; p < particles_.size(); ++p)
-    e += particles_.mass[p] * scene_.gravity * particles_.x[p][up_axis<Dim>];
-  return e;
-}
-
-template <int Dim>
-double Simulation<Dim>::cap_dissipated_energy() const {
-  if (!particles_.has_plastic_state()) return 0.0;
-  const double c = plastic_.tensile_strength_c, z = plastic_.softening_zeta;
-  double e = 0.0;
-  for (std::size_t p = 0; p < particles_.size(); ++p) {
-    const double eps = particles_.eps_v_p[p];
-    e += particles_.vol0[p] * (z > 0 ? c / z * (-std::expm1(-z * eps)) : c * eps);
-  }
-  return e;
-}
-
-template <int Dim>
-double Simulation<Dim>::max_yield_violation() const {
-  if (!particles_.has_plastic_state()) return 0.0;
-  double worst = -std::numeric_limits<double>::infinity();
-  for (std::size_t p = 0; p < particles_.size(); ++p) {
-    const double pr = pressure_of<Dim>(particles_.tau[p]);
-    const double q = von_mises_of<Dim>(particles_.tau[p]);
-    const double pc = cap_pressure(plastic_, particles_.eps_v_p[p]);
-    worst = std::max({worst, (pc - pr) / plastic_.tensile_strength_c,
-                      (q - shear_strength(plastic_, particles_.eps_v_p[p], pr)) / plastic_.tensile_strength_c});
-  }
-  return worst;
-}
-
-template <int Dim>
-ParticleSnapshot Simulation<Dim>::snapshot() const {
-  ParticleSnapshot s;
-  s.dim = Dim;
-  s.time_s = time_;
-  s.dx_m = scene_.dx;
-  s.softening_zeta = plastic_.softening_zeta;
-  s.tensile_strength_pa = scene_.tensile_strength;
-  s.ice_thickness_m = scene_.ice_thickness;
-  s.step_top_x_m = scene_.step_top_x();
-  s.step_foot_x_m = scene_.step_foot_x();
-  s.ice_front_x_m = ice_front_x();
-  s.particle_spacing_m = scene_.dx / scene_.particles_per_cell_axis;
-  if (bed_) s.bed_profile = bed_->vertices();
-  const auto& P = particles_;
-  const std::size_t n = P.size();
-  s.x.resize(n); s.z.resize(n); s.vx.resize(n); s.vz.resize(n);
-  if (Dim == 3) { s.y.resize(n); s.vy.resize(n); }
-  s.eps_v_p.assign(n, 0.0);
-  s.pressure_pa.resize(n); s.von_mises_pa.resize(n); s.sigma_zz_pa.resize(n); s.volume_m3.resize(n);
-  constexpr int z = up_axis<Dim>;
-  for (std::size_t p = 0; p < n; ++p) {
-    s.x[p] = P.x[p][0];
-    s.z[p] = P.x[p][z];
-    s.vx[p] = P.v[p][0];
-    s.vz[p] = P.v[p][z];
-    if constexpr (Dim == 3) { s.y[p] = P.x[p][1]; s.vy[p] = P.v[p][1]; }
-    const double eps = P.has_plastic_state() ? P.eps_v_p[p] : 0.0;
-    s.eps_v_p[p] = eps;
-    s.pressure_pa[p] = pressure_of<Dim>(P.tau[p]);
-    s.von_mises_pa[p] = von_mises_of<Dim>(P.tau[p]);
-    const double j_e = P.F_e[p].determinant();
-    // Cauchy σ = V0 τ / V: the force of a particle is V0 τ (MLS) and V = V0 J_E J_P.
-    s.sigma_zz_pa[p] = P.tau[p](z, z) / (j_e * std::exp(eps));
-    s.volume_m3[p] = P.vol0[p] * j_e * std::exp(eps);  // J = J_E J_P, J_P = exp(ε_v^p)
-  }
-  if (records_gate()) {
-    s.gate_x_m = scene_.gate_x();
-    s.gate_passed_length_m = gate_passed_length();
-    auto add = [&](const std::array<float, Dim>& xr, float eps) {
-      s.gate_x_ref.push_back(xr[0]);
-      s.gate_z_ref.push_back(xr[z]);
-      if constexpr (Dim == 3) s.gate_y_ref.push_back(xr[1]);
-      s.gate_eps_v_p.push_back(eps);
-    };
-    for (std::size_t i = 0; i < gate_archive_eps_.size(); ++i) add(gate_archive_x_[i], gate_archive_eps_[i]);
-    for (std::size_t p = 0; p < n; ++p)
-      if (P.gate_eps[p] >= 0.0f) add(P.x_ref[p], P.gate_eps[p]);
-  }
-  return s;
-}
-
-template <int Dim>
 void Simulation<Dim>::save_checkpoint(const std::string& path) const {
-  namespace ck = checkpoint;
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream o(tmp, std::ios::binary | std::ios::trunc);
-    if (!o) throw SimulationError("checkpoint: cannot write " + tmp);
-    ck::write_bytes(o, ck::kMagic, sizeof ck::kMagic);
-    ck::put_string(o, CREVASSE_ENGINE_VERSION);
-    ck::put_string(o, scene_to_json(scene_).dump());
-    ck::put(o, static_cast<std::int32_t>(Dim));
-    ck::put(o, time_); ck::put(o, dt_); ck::put(o, steps_); ck::put(o, particle_steps_);
-    ck::put(o, return_map_evaluations_); ck::put(o, removed_mass_); ck::put(o, front_x_);
-    ck::put(o, max_speed_); ck::put(o, static_cast<std::uint8_t>(settled_));
-    ck::put(o, gate_passed_volume_); ck::put(o, inflow_mass_); ck::put(o, inflow_columns_);
-    const auto& P = particles_;
-    ck::put_vector(o, P.x); ck::put_vector(o, P.v); ck::put_vector(o, P.C); ck::put_vector(o, P.F_e);
-    ck::put_vector(o, P.tau); ck::put_vector(o, P.mass); ck::put_vector(o, P.vol0);
-    ck::put_vector(o, P.eps_v_p); ck::put_vector(o, P.drive_x0); ck::put_vector(o, P.x_ref);
-    ck::put_vector(o, P.gate_eps); ck::put_vector(o, gate_archive_x_); ck::put_vector(o, gate_archive_eps_);
-    ck::write_bytes(o, ck::kMagic, sizeof ck::kMagic);  // end marker: a truncated file is refused
-    o.flush();
-    if (!o) throw SimulationError("checkpoint: writing " + tmp + " failed (disk full?)");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) throw SimulationError("checkpoint: cannot rename " + tmp + " to " + path + ": " + ec.message());
+  const RunCounters run{time_,         dt_,     steps_,    particle_steps_, return_map_evaluations_,
+                        removed_mass_, front_x_, max_speed_, settled_,       inflow_mass_,
+                        inflow_columns_};
+  crevasse::save_checkpoint(path, scene_, run, particles_, gate_);
 }
 
 template <int Dim>
 void Simulation<Dim>::load_checkpoint(const std::string& path) {
-  namespace ck = checkpoint;
-  std::ifstream i(path, std::ios::binary);
-  if (!i) throw SimulationError("checkpoint: cannot read " + path);
-  auto bad = [&](const std::string& why) { return SimulationError("checkpoint " + path + ": " + why); };
-  char magic[sizeof ck::kMagic] = {};
-  ck::read_bytes(i, magic, sizeof magic);
-  if (!i || !std::equal(magic, magic + sizeof magic, ck::kMagic)) throw bad("not a crevasse checkpoint");
-  if (ck::get_string(i, 64) != CREVASSE_ENGINE_VERSION) throw bad("written by another engine version");
-  if (ck::get_string(i, 1u << 24) != scene_to_json(scene_).dump()) throw bad("written for another scene");
-  std::int32_t dim = 0;
-  ck::get(i, dim);
-  if (dim != Dim) throw bad("written for another dimension");
-  double time = 0, dt = 0, removed = 0, front = 0, vmax = 0, gate_volume = 0, inflow_mass = 0;
-  std::int64_t steps = 0, psteps = 0, rmaps = 0, inflow_columns = 0;
-  std::uint8_t settled = 0;
-  ck::get(i, time); ck::get(i, dt); ck::get(i, steps); ck::get(i, psteps); ck::get(i, rmaps);
-  ck::get(i, removed); ck::get(i, front); ck::get(i, vmax); ck::get(i, settled); ck::get(i, gate_volume);
-  ck::get(i, inflow_mass); ck::get(i, inflow_columns);
-  Particles<Dim> P;
-  constexpr std::uint64_t kMax = std::uint64_t{1} << 34;
-  const bool ok = ck::get_vector(i, P.x, kMax) && ck::get_vector(i, P.v, kMax) &&
-                  ck::get_vector(i, P.C, kMax) && ck::get_vector(i, P.F_e, kMax) &&
-                  ck::get_vector(i, P.tau, kMax) && ck::get_vector(i, P.mass, kMax) &&
-                  ck::get_vector(i, P.vol0, kMax) && ck::get_vector(i, P.eps_v_p, kMax) &&
-                  ck::get_vector(i, P.drive_x0, kMax) && ck::get_vector(i, P.x_ref, kMax) &&
-                  ck::get_vector(i, P.gate_eps, kMax);
-  std::vector<std::array<float, Dim>> archive_x;
-  std::vector<float> archive_eps;
-  const bool ok2 = ok && ck::get_vector(i, archive_x, kMax) && ck::get_vector(i, archive_eps, kMax);
-  ck::read_bytes(i, magic, sizeof magic);
-  if (!ok2 || !i || !std::equal(magic, magic + sizeof magic, ck::kMagic)) throw bad("truncated or corrupt");
-  const std::size_t n = P.x.size();
-  auto size_ok = [&](std::size_t got, bool present) { return got == (present ? n : 0); };
-  if (P.v.size() != n || P.C.size() != n || P.F_e.size() != n || P.tau.size() != n ||
-      P.mass.size() != n || P.vol0.size() != n || !size_ok(P.eps_v_p.size(), particles_.has_plastic_state()) ||
-      !size_ok(P.drive_x0.size(), !particles_.drive_x0.empty()) ||
-      !size_ok(P.x_ref.size(), records_gate()) || !size_ok(P.gate_eps.size(), records_gate()) ||
-      archive_x.size() != archive_eps.size())
-    throw bad("array sizes disagree");
-  particles_ = std::move(P);
-  gate_archive_x_ = std::move(archive_x);
-  gate_archive_eps_ = std::move(archive_eps);
-  time_ = time; dt_ = dt; steps_ = steps; particle_steps_ = psteps; return_map_evaluations_ = rmaps;
-  removed_mass_ = removed; front_x_ = front; max_speed_ = vmax; settled_ = settled != 0;
-  settling_ = false; gate_passed_volume_ = gate_volume;
-  inflow_mass_ = inflow_mass; inflow_columns_ = inflow_columns;
-}
-
-template <int Dim>
-double Simulation<Dim>::ice_front_x(double min_fraction) const {
-  const auto& P = particles_;
-  if (P.size() == 0) return 0.0;
-  const double dx = scene_.dx;
-  double xmin = P.x[0][0], xmax = xmin;
-  for (std::size_t p = 0; p < P.size(); ++p) {
-    xmin = std::min(xmin, P.x[p][0]);
-    xmax = std::max(xmax, P.x[p][0]);
-  }
-  const auto columns = static_cast<std::size_t>((xmax - xmin) / dx) + 1;
-  std::vector<double> volume(columns, 0.0);
-  for (std::size_t p = 0; p < P.size(); ++p)
-    volume[static_cast<std::size_t>((P.x[p][0] - xmin) / dx)] += P.mass[p] / scene_.density;
-  double across = 1.0;  // 3D: the width of the ice across the flow
-  if constexpr (Dim == 3) across = scene_.body == "slab" ? scene_.width : scene_.box_max[1] - scene_.box_min[1];
-  const double thickness = scene_.body == "slab" ? scene_.ice_thickness
-                                                 : scene_.box_max[Dim - 1] - scene_.box_min[Dim - 1];
-  const double full = min_fraction * thickness * dx * across;
-  // Gaps upstream of the step top (a crack near the piston) do not end the ice: the walk
-  // only stops at a gap downstream of it.
-  const double gaps_from_x = scene_.body == "slab" ? scene_.step_top_x() : xmin;
-  std::size_t last_thick = 0;
-  int thin_run = 0;
-  for (std::size_t c = 0; c < columns; ++c) {
-    if (volume[c] >= full) {
-      last_thick = c;
-      thin_run = 0;
-    } else if (xmin + c * dx >= gaps_from_x && ++thin_run >= 2) {
-      break;
-    }
-  }
-  return std::min(xmax, xmin + (last_thick + 1) * dx);
+  RunCounters r;
+  crevasse::load_checkpoint(path, scene_, r, particles_, gate_);
+  time_ = r.time; dt_ = r.dt; steps_ = r.steps; particle_steps_ = r.particle_steps;
+  return_map_evaluations_ = r.return_map_evaluations; removed_mass_ = r.removed_mass; front_x_ = r.front_x;
+  max_speed_ = r.max_speed; settled_ = r.settled; settling_ = false;
+  inflow_mass_ = r.inflow_mass; inflow_columns_ = r.inflow_columns;
 }
 
 template class Simulation<2>;

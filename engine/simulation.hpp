@@ -13,11 +13,14 @@
 #include <vector>
 
 #include "engine/bed.hpp"
+#include "engine/bed_field.hpp"
 #include "engine/bspline.hpp"
 #include "engine/capped_von_mises.hpp"
+#include "engine/gate_recorder.hpp"
 #include "engine/grid.hpp"
 #include "engine/hencky.hpp"
 #include "engine/particles.hpp"
+#include "engine/readouts.hpp"
 #include "engine/scene.hpp"
 #include "engine/snapshot.hpp"
 
@@ -56,27 +59,28 @@ class Simulation {
   std::int64_t return_map_evaluations() const { return return_map_evaluations_; }
   std::int64_t particle_steps() const { return particle_steps_; }
 
-  // Diagnostics (conservation checks, hard-case assertions).
-  double total_mass() const;
+  // Diagnostics (conservation checks, hard-case assertions; engine/readouts.hpp).
+  double total_mass() const { return crevasse::total_mass(particles_); }
   double removed_mass() const { return removed_mass_; }
   double inflow_mass() const { return inflow_mass_; }  // mass that entered through the inflow
-  Vec<Dim> total_momentum() const;
-  double kinetic_energy() const;
-  double gravitational_potential_energy() const;
-  // Energy dissipated by the tensile cap, Σ V0 ∫ c e^{−ζε} dε = Σ V0 (c/ζ)(1 − e^{−ζ ε_v^p}).
-  double cap_dissipated_energy() const;
+  Vec<Dim> total_momentum() const { return crevasse::total_momentum(particles_); }
+  double kinetic_energy() const { return crevasse::kinetic_energy(particles_); }
+  double gravitational_potential_energy() const {
+    return crevasse::gravitational_potential_energy(particles_, scene_.gravity);
+  }
+  double cap_dissipated_energy() const { return crevasse::cap_dissipated_energy(particles_, plastic_); }
   double front_x() const { return front_x_; }  // most downstream particle, debris included
-  // Front of the connected ice [m]: walking downstream from the back in columns one cell wide,
-  // the right edge of the last column holding at least `min_fraction` of a full column of ice
-  // (H_i thick) before two thinner columns in a row. Scattered debris ahead of the ice does
-  // not count. O(particles); the run loop calls it every few steps.
-  double ice_front_x(double min_fraction = 0.25) const;
+  // Front of the connected ice; O(particles), the run loop calls it every few steps.
+  double ice_front_x(double min_fraction = 0.25) const {
+    return crevasse::ice_front_x(particles_, scene_, min_fraction);
+  }
   double max_speed() const { return max_speed_; }
   const Bed* bed() const { return bed_.has_value() ? &*bed_ : nullptr; }
-  // Largest yield-function value Φ over the particles, normalised by c (≤ ~0 when admissible).
-  double max_yield_violation() const;
+  double max_yield_violation() const { return crevasse::max_yield_violation(particles_, plastic_); }
 
-  ParticleSnapshot snapshot() const;
+  ParticleSnapshot snapshot() const {
+    return make_snapshot(particles_, scene_, plastic_, time_, bed(), records_gate() ? &gate_ : nullptr);
+  }
 
   // Checkpoints (engine/checkpoint.hpp): the whole state the next step reads, written atomically
   // (temporary file, then rename). load_checkpoint throws SimulationError when the file is not a
@@ -87,7 +91,7 @@ class Simulation {
   // Measurement gate at scene.gate_x() (when scene.records_gate()): the ice length along flow
   // that has reached it, Σ V0 of the particles recorded / the slab's cross-section [m].
   bool records_gate() const { return !particles_.gate_eps.empty(); }
-  double gate_passed_length() const;
+  double gate_passed_length() const { return records_gate() ? gate_.passed_length() : 0.0; }
 
  private:
   struct Stage {
@@ -114,8 +118,6 @@ class Simulation {
   };
   ParticleTail particle_tail() const;
   [[gnu::always_inline]] inline void finish_particle(std::size_t p, const ParticleTail& tail, StepSummary& acc);
-  void seed_particles();
-  void build_bed_table();
 
   // Stages.
   void prepare_grid();
@@ -125,12 +127,7 @@ class Simulation {
   template <class Fn>
   void for_each_particle_coloured(Fn&& fn);  // race-free P2G-style traversal by x-slab parity
   void grid_velocity(const Vec<Dim>& gravity);
-  void drive_grid_nodes();
-  void drive_downstream_nodes();
-  void drive_inflow_nodes();
-  // Nodes with mass and x in [x_lo, x_hi] move at the drive speed along x (and, when
-  // hold_vertical, not at all vertically).
-  void hold_nodes_at_drive_speed(double x_lo, double x_hi, bool hold_vertical);
+  double drive_speed_now() const { return settling_ ? 0.0 : scene_.drive_velocity(time_); }
   // The inflow holds the nodes up to this many cells from the back: a quadratic stencil reaches
   // 1.5 cells, so the ice within 2.5 cells of the back gathers only held nodes, which covers the
   // band the inflow copies (x < 2h ≤ 2 dx) at any particles per cell.
@@ -139,9 +136,6 @@ class Simulation {
   // downstream_drive holds the nodes of this many cells upstream of the domain's end (the
   // outflow line is 3 cells from it, so 2 cells of ice before it move at the drive speed).
   static constexpr double kDownstreamDriveCells = 5.0;
-  void apply_bed_friction_to_grid();
-  void apply_walls_to_grid(const std::vector<int>& axes, const Vec<Dim>& lo, const Vec<Dim>& hi);
-  void apply_velocity_boxes_to_grid();
   template <bool Plastic>
   void grid_to_particle();  // gather + update fused (no volume averaging)
   void gather_velocity(std::size_t p, const StencilWeights<Dim>& w, const StencilOffsets<Dim>& d,
@@ -177,21 +171,8 @@ class Simulation {
   void finish_step();
   void remove_outflow();
   void inflow();
-  void init_gate();
-  // gate_eps of a particle not recorded yet, and of one that started past the gate; recorded
-  // values are ε_v^p ≥ 0.
-  static constexpr float kGateNotYet = -1.0f, kGateNever = -2.0f;
-  void record_gate();
   void update_time_step();
 
-  double bed_phi(const Vec<Dim>& x, Vec<Dim>* normal) const;
-  struct BedCell {
-    int i, k;       // the bed table's cell
-    double fx, fz;  // place in it, in [0, 1]
-  };
-  BedCell bed_cell(const Vec<Dim>& x) const;
-  double bed_phi(const BedCell& cell, Vec<Dim>* normal) const;
-  [[gnu::always_inline]] inline void project_out_of_bed(std::size_t p);  // one particle's bed projection (finish_particle)
 
   SceneConfig scene_;
   ElasticModuli moduli_;
@@ -199,14 +180,9 @@ class Simulation {
   Particles<Dim> particles_;
   Grid<Dim> grid_;
   std::optional<Bed> bed_;
-  // Bed signed distance and normal on the lattice nodes of the domain, indexed (x, z).
-  std::vector<double> bed_phi_;
-  std::vector<std::array<double, 2>> bed_normal_;
-  std::vector<int> bed_clear_k_;  // per cell column: from this cell row up, φ ≥ 0 at every corner
-  std::vector<double> bed_clear_z_;  // per cell column: above this z, the particle's cell is clear
-  double bed_inv_dx_ = 1.0;
+  BedField<Dim> bed_field_;  // the bed as contact and projection read it (scenes with a bed)
+  GateRecorder<Dim> gate_;   // scenes that record a gate (records_gate())
   bool per_particle_update_ = false;
-  int bed_i0_ = 0, bed_k0_ = 0, bed_ni_ = 0, bed_nk_ = 0;
 
   std::vector<Stage> stage_fns_;
   std::vector<StageStats> stages_;
@@ -236,14 +212,9 @@ class Simulation {
   double removed_mass_ = 0.0;
   double inflow_mass_ = 0.0;
   std::int64_t inflow_columns_ = 0;  // columns seeded by the inflow so far
-  // Gate records of particles since removed by the outflow: initial position, ε_v^p at the gate.
-  std::vector<std::array<float, Dim>> gate_archive_x_;
-  std::vector<float> gate_archive_eps_;
   // Largest physically possible particle speed [m/s] (slab scenes with gravity; 0 = none):
   // a faster particle means a numerical instability (update_time_step).
   double speed_bound_ = 0.0;
-  double gate_passed_volume_ = 0.0;   // Σ V0 of every particle recorded at the gate
-  double gate_cross_section_ = 1.0;   // slab V0 per unit length along flow [m^(Dim−1)]
   double front_x_ = 0.0;
   double max_speed_ = 0.0;
   bool settled_ = false;
