@@ -16,6 +16,7 @@
 #include "engine/error.hpp"
 #include "engine/fast_math.hpp"
 #include "engine/grid_boundaries.hpp"
+#include "engine/particle_update.hpp"
 #include "engine/seeding.hpp"
 
 namespace crevasse {
@@ -128,30 +129,31 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
     });
   }
   const bool plastic = scene_.has(Effect::plasticity);
-  if (scene_.volumetric_averaging) {
+  // The particle update: with the average, after a sweep that gathers the velocities and
+  // scatters the volume change; without, the gather is fused into it.
+  const bool average = scene_.volumetric_averaging;
+  if (average) {
     add_stage("g2p_velocity", [this] { gather_velocities_and_scatter_volume(); });
     add_stage("volume_averaging", [this] { normalise_volume_average(); });
-    if (plastic) {
-      add_stage("g2p_return_mapping", [this] {
-        if (settling_) update_all_particles<false>();
-        else update_all_particles<true>();
-      });
-    } else {
-      add_stage("g2p_elastic", [this] { update_all_particles<false>(); });
-    }
-  } else if (plastic) {
-    add_stage("g2p_return_mapping", [this] {
-      if (settling_) grid_to_particle<false>();
-      else grid_to_particle<true>();
+  }
+  if (plastic) {
+    // No return mapping while settling: the settled state is elastic by construction.
+    add_stage("g2p_return_mapping", [this, average] {
+      if (average) settling_ ? update_particles<false, true>() : update_particles<true, true>();
+      else settling_ ? update_particles<false, false>() : update_particles<true, false>();
     });
   } else {
-    add_stage("g2p_elastic", [this] { grid_to_particle<false>(); });
+    add_stage("g2p_elastic", [this, average] {
+      average ? update_particles<false, true>() : update_particles<false, false>();
+    });
   }
-  // Applied by the update sweep to each particle as it is written (finish_particle).
-  tail_effects_.bed = scene_.has(Effect::basal_friction);
-  tail_effects_.drive = scene_.has(Effect::drive) && !has_inflow;  // the piston's kinematic layer
-  if (tail_effects_.bed) particle_effects_.push_back("bed_projection");
-  if (tail_effects_.drive) particle_effects_.push_back("drive");
+  // Applied by the update sweep to each particle as it is written (engine/particle_effects.hpp).
+  effects_.bed = scene_.has(Effect::basal_friction);
+  effects_.piston = scene_.has(Effect::drive) && !has_inflow;  // the piston's kinematic layer
+  effects_.lo = domain_lo_;
+  effects_.hi = domain_hi_;
+  if (effects_.bed) particle_effects_.push_back("bed_projection");
+  if (effects_.piston) particle_effects_.push_back("drive");
   // Particles never leave the domain: the last line of defence, whatever the effects.
   particle_effects_.push_back("domain_clamp");
   if (scene_.records_gate()) add_stage("gate", [this] { gate_.record(particles_); });
@@ -388,100 +390,6 @@ template <int Dim>
   particles_.C[p] = c_scale * b;
 }
 
-// pow(s, 1/d), the root of a volume ratio; in 2D by pow_half, the same double at less cost.
-template <int Dim>
-inline double volume_root(double s) {
-  if constexpr (Dim == 2) return pow_half(s);
-  else return std::pow(s, 1.0 / Dim);
-}
-
-template <int Dim>
-template <bool Plastic>
-void Simulation<Dim>::update_particle(std::size_t p, double volume_scale, double softening) {
-  // Move, update F_E ← ΔF·F_E (ΔF optionally rescaled to the averaged volume change), then
-  // the stress, through the return mapping when the scene is plastic.
-  auto& P = particles_;
-  P.x[p] += dt_ * P.v[p];
-  Mat<Dim> df = Mat<Dim>::Identity() + dt_ * P.C[p];
-  if (volume_scale != 1.0) df *= volume_root<Dim>(volume_scale);
-  const Mat<Dim> fe = df * P.F_e[p];
-  store_trial_state<Plastic>(p, fe, principal_hencky<Dim>(fe), softening);
-}
-
-template <int Dim>
-template <bool Plastic>
-[[gnu::always_inline]] inline void Simulation<Dim>::store_trial_state(std::size_t p, Mat<Dim> fe,
-                                                                      PrincipalStretch<Dim> s,
-                                                                      double softening) {
-  // From the trial F_E and its principal Hencky strains: the return mapping when the scene is
-  // plastic, then F_E and the stress.
-  auto& P = particles_;
-  if constexpr (Plastic) {
-    const ReturnResult<Dim> ret = return_map_capped_von_mises<Dim>(s.eps, P.eps_v_p[p], moduli_, plastic_, softening);
-    if (ret.cap_active || ret.shear_active) {
-      // F_E = U exp(ε') Uᵀ R: rescale the left stretch in its principal frame.
-      const Vec<Dim> scale = (ret.eps - s.eps).array().exp();
-      fe = s.U * scale.asDiagonal() * s.U.transpose() * fe;
-      s.eps = ret.eps;
-      P.eps_v_p[p] += ret.delta_eps_v;
-    }
-  }
-  P.F_e[p] = fe;
-  P.tau[p] = kirchhoff_stress<Dim>(moduli_, s);
-}
-
-template <int Dim>
-typename Simulation<Dim>::ParticleTail Simulation<Dim>::particle_tail() const {
-  ParticleTail t = tail_effects_;
-  if (t.drive && !settling_) {
-    // The piston's place at the end of this step: finish_step's time_ + dt_.
-    const double end_time = time_ + dt_;
-    t.drive_shift = scene_.drive_position(end_time);
-    t.drive_v = scene_.drive_velocity(end_time);
-  }
-  return t;
-}
-
-template <int Dim>
-[[gnu::always_inline]] inline void Simulation<Dim>::finish_particle(std::size_t p, const ParticleTail& tail,
-                                                                    StepSummary& acc) {
-  auto& P = particles_;
-  if (tail.bed) bed_field_.project_out(P.x[p]);
-  if (tail.drive && !std::isnan(P.drive_x0[p])) {
-    // The piston is the back layer of ice (one cell thick), moved kinematically along x at the
-    // drive speed and free to slide vertically. A grid-node wall instead gives the ice an
-    // impulse each time its face crosses a node column, which builds a grid-scale stress
-    // oscillation behind the face (seen as tensile bands that crack the back of the slab).
-    P.x[p][0] = P.drive_x0[p] + tail.drive_shift;
-    P.v[p][0] = tail.drive_v;
-    P.C[p].row(0).setZero();
-  }
-  for (int a = 0; a < Dim; ++a) P.x[p][a] = std::clamp(P.x[p][a], domain_lo_[a], domain_hi_[a]);
-  summarise_particle(p, acc);
-}
-
-template <int Dim>
-template <bool Plastic>
-void Simulation<Dim>::grid_to_particle() {
-  auto& P = particles_;
-  const ParticleTail tail = particle_tail();
-  summary_ = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, P.size(), kGrain), StepSummary{},
-      [&](const auto& r, StepSummary acc) {
-        const double dx = scene_.dx, inv_dx = 1.0 / dx, c_scale = 4.0 * inv_dx * inv_dx;
-        for (std::size_t p = r.begin(); p != r.end(); ++p) {
-          const Vec<Dim> xg = P.x[p] * inv_dx;
-          const StencilWeights<Dim> w(xg);
-          gather_velocity(p, w, StencilOffsets<Dim>(w, xg, dx), grid_.flat(w.base()), c_scale);
-          update_particle<Plastic>(p, 1.0, Plastic ? softening_factor(plastic_, P.eps_v_p[p]) : 1.0);
-          finish_particle(p, tail, acc);
-        }
-        return acc;
-      },
-      merge);
-  finish_step<Plastic>();
-}
-
 // ΔJ-bar (cf. the F-bar family, e.g. Coombs et al. 2018, CMAME 333:1–21): the step's volume
 // ratio ΔJ_p = det(I + Δt C_p) is mass-averaged onto the grid nodes with the same quadratic
 // weights as P2G and interpolated back; each particle then takes the averaged ΔJ̄_p and keeps
@@ -557,50 +465,6 @@ template <int Dim>
   return v;
 }
 
-// ΔJ_used/ΔJ_p, with `intact` = 1 − D the particle's share of the average. Selects, no branch
-// (a lane's unused quotient may be inf or NaN; it is never selected).
-inline double volume_scale_of(double jbar, double wsum, double dj, double intact) {
-  const double averaged = intact * (jbar / wsum) + (1.0 - intact) * dj;
-  const double used = wsum > 0.0 ? averaged : dj;
-  const double ratio = used / dj;
-  return (dj > 0.0 && used > 0.0) ? ratio : 1.0;
-}
-
-template <int Dim>
-[[gnu::always_inline]] inline double Simulation<Dim>::averaged_volume_scale(std::size_t p, const StencilWeights<Dim>& w,
-                                              double intact) const {
-  const VolumeSums v = volume_sums(p, w);
-  return volume_scale_of(v.jbar, v.wsum, v.dj, intact);
-}
-
-template <int Dim>
-template <bool Plastic>
-void Simulation<Dim>::update_all_particles() {
-  const double inv_dx = 1.0 / scene_.dx;
-  const bool damage = averaging_weights_damage();
-  const bool plastic = !softening_.empty();
-  const ParticleTail tail = particle_tail();
-  summary_ = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, particles_.size(), kGrain), StepSummary{},
-      [&](const auto& r, StepSummary acc) {
-        if constexpr (Dim == 2) {
-          if (!per_particle_update_) {
-            update_particles_2d<Plastic>(r.begin(), r.end(), damage, plastic, tail, acc);
-            return acc;
-          }
-        }
-        for (std::size_t p = r.begin(); p != r.end(); ++p) {
-          const StencilWeights<Dim> w(Vec<Dim>(particles_.x[p] * inv_dx));
-          const double f = plastic ? softening_[p] : 1.0;
-          update_particle<Plastic>(p, averaged_volume_scale(p, w, damage ? f : 1.0), f);
-          finish_particle(p, tail, acc);
-        }
-        return acc;
-      },
-      merge);
-  finish_step<Plastic>();
-}
-
 // The 2D update of particles [begin, end), a block of kBlock at a time, with the results of
 // update_particle to the bit (bench/state_hash checks it on whole glacier runs). Per block:
 // (1) one by one, the stencil gather of the ΔJ̄ sums; (2) over the block, the volume ratio and
@@ -612,102 +476,69 @@ void Simulation<Dim>::update_all_particles() {
 // block's trial state through the return mapping (store_trial_state), as in update_particle;
 // each particle then takes the step's per-particle effects (finish_particle).
 template <int Dim>
-template <bool Plastic>
-void Simulation<Dim>::update_particles_2d(std::size_t begin, std::size_t end, bool damage,
-                                          bool plastic, const ParticleTail& tail,
-                                          StepSummary& acc) {
-  static_assert(Dim == 2);
-  constexpr std::size_t kBlock = 32;
-  auto& P = particles_;
-  const double inv_dx = 1.0 / scene_.dx;
-  const double dt = dt_;
-  const ElasticModuli moduli = moduli_;
-  const CappedVonMisesParams plastic_params = plastic_;
-  double jbar[kBlock], wsum[kBlock], dj[kBlock], vs[kBlock], scale[kBlock], soft[kBlock];
-  std::int64_t need_pow[kBlock];
-  double f00[kBlock], f01[kBlock], f10[kBlock], f11[kBlock];
-  double m[kBlock], h[kBlock], d[kBlock], r[kBlock], jm1[kBlock], e0[kBlock], e1[kBlock];
-  double t00[kBlock], t11[kBlock], t01[kBlock], ux[kBlock], uy[kBlock];
-  std::int64_t spread[kBlock];
-  std::int64_t elastic[kBlock];  // 0 or 1: the width of a double, so that the loop below vectorises
-  for (std::size_t b = begin; b < end; b += kBlock) {
-    const std::size_t n = std::min(kBlock, end - b);
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::size_t p = b + i;
-      const VolumeSums v = volume_sums(p, StencilWeights<2>(Vec<2>(P.x[p] * inv_dx)));
-      jbar[i] = v.jbar;
-      wsum[i] = v.wsum;
-      dj[i] = v.dj;
-      soft[i] = plastic ? softening_[p] : 1.0;
-    }
-    // The volume ratio and its root (pow_half split in two: the square root and its test over
-    // the block, pow one by one where the test fails). ΔF·s with s = 1 is exact, so the
-    // unscaled particles need no branch below.
-    for (std::size_t i = 0; i < n; ++i) {
-      vs[i] = volume_scale_of(jbar[i], wsum[i], dj[i], damage ? soft[i] : 1.0);
-      const double root = std::sqrt(vs[i]);
-      const bool unscaled = vs[i] == 1.0;
-      scale[i] = unscaled ? 1.0 : root;
-      need_pow[i] = !unscaled & !sqrt_is_pow_half(vs[i], root);
-    }
-    for (std::size_t i = 0; i < n; ++i)
-      if (need_pow[i]) scale[i] = std::pow(vs[i], 0.5);
-    for (std::size_t i = 0; i < n; ++i) {
-      const double* c = P.C[b + i].data();  // column-major: C00, C10, C01, C11
-      const double* fe = P.F_e[b + i].data();
-      const double s = scale[i];
-      const double d00 = (1.0 + dt * c[0]) * s, d10 = (0.0 + dt * c[1]) * s;
-      const double d01 = (0.0 + dt * c[2]) * s, d11 = (1.0 + dt * c[3]) * s;
-      f00[i] = d00 * fe[0] + d01 * fe[1];
-      f10[i] = d10 * fe[0] + d11 * fe[1];
-      f01[i] = d00 * fe[2] + d01 * fe[3];
-      f11[i] = d10 * fe[2] + d11 * fe[3];
-      const detail::Hencky2dParts q = detail::hencky_2d_parts(f00[i], f01[i], f10[i], f11[i]);
-      m[i] = q.m;
-      h[i] = q.h;
-      d[i] = q.d;
-      r[i] = q.r;
-      jm1[i] = q.j_minus_1;
-    }
-    for (std::size_t i = 0; i < n; ++i) {
-      e1[i] = 0.5 * std::log1p(m[i] + r[i]);
-      e0[i] = std::log1p(jm1[i]) - e1[i];
-    }
-    for (std::size_t i = 0; i < n; ++i) {
-      spread[i] = detail::hencky_2d_frame({m[i], h[i], d[i], r[i], jm1[i]}, ux[i], uy[i]);
-      kirchhoff_stress_2d(moduli, e0[i], e1[i], ux[i], uy[i], t00[i], t11[i], t01[i]);
-      if constexpr (Plastic) elastic[i] = admissible_2d(e0[i], e1[i], moduli, plastic_params, soft[i]);
-    }
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::size_t p = b + i;
-      P.x[p] += dt * P.v[p];
-      if constexpr (Plastic) {
-        if (!elastic[i]) {
-          // Outside a yield surface: the return mapping, from the block's trial state, which
-          // is update_particle's to the bit (principal_hencky_2d chains the same parts).
-          Mat<2> trial;
-          trial << f00[i], f01[i], f10[i], f11[i];
-          PrincipalStretch<2> st;
-          st.eps << e0[i], e1[i];
-          st.U << uy[i], ux[i], spread[i] ? -ux[i] : 0.0, uy[i];
-          store_trial_state<true>(p, trial, st, soft[i]);
-          finish_particle(p, tail, acc);
-          continue;
-        }
-      }
-      Mat<2>& fe = P.F_e[p];
-      fe(0, 0) = f00[i];
-      fe(1, 0) = f10[i];
-      fe(0, 1) = f01[i];
-      fe(1, 1) = f11[i];
-      Mat<2>& tau = P.tau[p];
-      tau(0, 0) = t00[i];
-      tau(1, 1) = t11[i];
-      tau(0, 1) = t01[i];
-      tau(1, 0) = t01[i];
-      finish_particle(p, tail, acc);
-    }
+ParticleEffects<Dim> Simulation<Dim>::particle_effects_now() const {
+  ParticleEffects<Dim> e = effects_;
+  if (e.piston && !settling_) {
+    // The piston's place at the end of this step: finish_step's time_ + dt_.
+    const double end_time = time_ + dt_;
+    e.piston_shift = scene_.drive_position(end_time);
+    e.piston_speed = scene_.drive_velocity(end_time);
   }
+  return e;
+}
+
+template <int Dim>
+template <bool Plastic, bool Average>
+void Simulation<Dim>::update_particles() {
+  auto& P = particles_;
+  const double dx = scene_.dx, inv_dx = 1.0 / dx, c_scale = 4.0 * inv_dx * inv_dx;
+  const bool damage = Average && averaging_weights_damage();
+  const bool kept_softening = !softening_.empty();  // P2G kept e^{−ζ ε_v^p} (averaged, plastic)
+  const ParticleEffects<Dim> effects = particle_effects_now();
+  // What the update needs of particle p first: with the average, its stencil's sums (its velocity
+  // was gathered by gather_velocities_and_scatter_volume); without, the gather itself.
+  const auto inputs = [&](std::size_t p, double& jbar, double& wsum, double& dj,
+                          double& soft) __attribute__((always_inline)) {
+    const Vec<Dim> xg = P.x[p] * inv_dx;
+    const StencilWeights<Dim> w(xg);
+    if constexpr (Average) {
+      const VolumeSums v = volume_sums(p, w);
+      jbar = v.jbar;
+      wsum = v.wsum;
+      dj = v.dj;
+      soft = kept_softening ? softening_[p] : 1.0;
+    } else {
+      gather_velocity(p, w, StencilOffsets<Dim>(w, xg, dx), grid_.flat(w.base()), c_scale);
+      jbar = 0.0;
+      wsum = 0.0;
+      dj = 1.0;
+      soft = Plastic ? softening_factor(plastic_, P.eps_v_p[p]) : 1.0;
+    }
+  };
+  summary_ = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, P.size(), kGrain), StepSummary{},
+      [&](const auto& r, StepSummary acc) {
+        const auto finish = [&](std::size_t p) __attribute__((always_inline)) {
+          effects.apply(P, p, bed_field_);
+          summarise_particle(p, acc);
+        };
+        if constexpr (Dim == 2) {
+          if (!per_particle_update_) {
+            update_particles_2d<Plastic>(P, r.begin(), r.end(), dt_, damage, moduli_, plastic_, inputs, finish);
+            return acc;
+          }
+        }
+        for (std::size_t p = r.begin(); p != r.end(); ++p) {
+          double jbar, wsum, dj, soft;
+          inputs(p, jbar, wsum, dj, soft);
+          const double scale = volume_scale_of(jbar, wsum, dj, damage ? soft : 1.0);
+          update_particle<Dim, Plastic>(P, p, dt_, scale, soft, moduli_, plastic_);
+          finish(p);
+        }
+        return acc;
+      },
+      merge);
+  finish_step<Plastic>();
 }
 
 template <int Dim>

@@ -19,6 +19,7 @@
 #include "engine/gate_recorder.hpp"
 #include "engine/grid.hpp"
 #include "engine/hencky.hpp"
+#include "engine/particle_effects.hpp"
 #include "engine/particles.hpp"
 #include "engine/readouts.hpp"
 #include "engine/scene.hpp"
@@ -49,7 +50,7 @@ class Simulation {
   const Particles<Dim>& particles() const { return particles_; }
   Particles<Dim>& mutable_particles() { return particles_; }  // tests and initial conditions
   // Tests: update 2D particles one at a time (update_particle) instead of in vectorised blocks
-  // (update_particles_2d); the two must agree bit for bit.
+  // (update_particles_2d, engine/particle_update.hpp); the two must agree bit for bit.
   void set_per_particle_update(bool on) { per_particle_update_ = on; }
   const std::vector<StageStats>& stages() const { return stages_; }
   // The per-particle effects that the update sweep applies to each particle right after its
@@ -109,15 +110,9 @@ class Simulation {
   static StepSummary merge(StepSummary a, const StepSummary& b);
   [[gnu::always_inline]] inline void summarise_particle(std::size_t p, StepSummary& acc) const;
   StepSummary summarise_particles() const;
-  // What the update sweep does to each particle after its update (particle_effects()), and the
-  // particle's share of the time step's summary. The drive's place and speed are those at the
-  // end of the step.
-  struct ParticleTail {
-    bool bed = false, drive = false;
-    double drive_shift = 0.0, drive_v = 0.0;
-  };
-  ParticleTail particle_tail() const;
-  [[gnu::always_inline]] inline void finish_particle(std::size_t p, const ParticleTail& tail, StepSummary& acc);
+  // The scene's per-particle effects (particle_effects()) with the piston's place and speed at
+  // the end of this step.
+  ParticleEffects<Dim> particle_effects_now() const;
 
   // Stages.
   void prepare_grid();
@@ -136,20 +131,13 @@ class Simulation {
   // downstream_drive holds the nodes of this many cells upstream of the domain's end (the
   // outflow line is 3 cells from it, so 2 cells of ice before it move at the drive speed).
   static constexpr double kDownstreamDriveCells = 5.0;
-  template <bool Plastic>
-  void grid_to_particle();  // gather + update fused (no volume averaging)
   void gather_velocity(std::size_t p, const StencilWeights<Dim>& w, const StencilOffsets<Dim>& d,
                        std::size_t f0, double c_scale);
-  template <bool Plastic>
-  void update_particle(std::size_t p, double volume_scale, double softening);  // softening: e^{−ζ ε_v^p}
-  template <bool Plastic>
-  void store_trial_state(std::size_t p, Mat<Dim> fe, PrincipalStretch<Dim> s, double softening);
   // ΔJ-bar volume averaging fused into the G2P sweeps (simulation.cpp explains it): gather v, C
   // and scatter the weighted ΔJ in one coloured sweep; normalise per node; the update sweep
   // interpolates ΔJ̄ back and updates the particle at once.
   void gather_velocities_and_scatter_volume();
   void normalise_volume_average();
-  double averaged_volume_scale(std::size_t p, const StencilWeights<Dim>& w, double intact) const;
   struct VolumeSums {
     double jbar, wsum, dj;
   };
@@ -161,18 +149,16 @@ class Simulation {
   double averaging_weight(std::size_t p, bool damage) const {
     return particles_.mass[p] * (damage ? softening_[p] : 1.0);
   }
-  template <bool Plastic>
-  void update_all_particles();
-  // 2D: the same update over a block of particles at a time (simulation.cpp).
-  template <bool Plastic>
-  void update_particles_2d(std::size_t begin, std::size_t end, bool damage, bool plastic,
-                           const ParticleTail& tail, StepSummary& acc);
+  // G2P's update sweep: the particle update (engine/particle_update.hpp), the per-particle
+  // effects, the time step's summary. Average: after the ΔJ-bar sweeps; otherwise the velocity
+  // gather is fused into it.
+  template <bool Plastic, bool Average>
+  void update_particles();
   template <bool Plastic>
   void finish_step();
   void remove_outflow();
   void inflow();
   void update_time_step();
-
 
   SceneConfig scene_;
   ElasticModuli moduli_;
@@ -187,7 +173,7 @@ class Simulation {
   std::vector<Stage> stage_fns_;
   std::vector<StageStats> stages_;
   std::vector<std::string> particle_effects_;
-  ParticleTail tail_effects_;  // which of them the scene has (the drive's place is per step)
+  ParticleEffects<Dim> effects_;  // which of them the scene has (the piston's place is per step)
   // The summary the update sweep reduced, for the time step of the same step (steps_ then);
   // stale once the outflow has removed particles.
   StepSummary summary_;

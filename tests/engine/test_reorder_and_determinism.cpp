@@ -157,9 +157,9 @@ TEST(ThreadCount, TwoDimensionalGlacierIsBitwiseIdenticalOnOneAndTwoThreads) {
   expect_thread_count_independent<2>(jittered_glacier(g, 0.4), 1500);
 }
 
-// The 2D update runs over vectorised blocks of particles (engine 5d23663); one particle at a
+// The 2D update runs over vectorised blocks of particles (update_particles_2d); one particle at a
 // time, through update_particle, it must give the same bits, cracks included (the block hands
-// particles outside a yield surface to update_particle; the rest it computes itself).
+// particles outside a yield surface to the return mapping; the rest it computes itself).
 // Returns the block-updated particles.
 Particles<2> expect_block_update_matches_per_particle(const SceneConfig& scene, int steps) {
   Simulation<2> block(scene), single(scene);
@@ -178,6 +178,19 @@ TEST(BlockUpdate, TwoDimensionalGlacierGivesTheParticleByParticleBits) {
   g.cells_per_thickness = 10.0;
   const Particles<2> a = expect_block_update_matches_per_particle(jittered_glacier(g, 0.4), 1500);
   // The run must have broken ice, or the block's hand-over to the return mapping was not tested.
+  const auto& e = a.eps_v_p;
+  EXPECT_GT(std::count_if(e.begin(), e.end(), [](double v) { return v > 0.0; }), 0);
+}
+
+// Without the ΔJ-bar average the block gathers each particle's velocity itself and takes no
+// volume scale: the same bits as one particle at a time, cracks included.
+TEST(BlockUpdate, GlacierWithoutVolumeAveragingGivesTheParticleByParticleBits) {
+  test::SmallGlacier g;
+  g.cohesion_ratio = 0.05;
+  g.cells_per_thickness = 10.0;
+  SceneConfig s = jittered_glacier(g, 0.4);
+  s.volumetric_averaging = false;
+  const Particles<2> a = expect_block_update_matches_per_particle(test::finish(s), 1500);
   const auto& e = a.eps_v_p;
   EXPECT_GT(std::count_if(e.begin(), e.end(), [](double v) { return v > 0.0; }), 0);
 }
