@@ -30,10 +30,10 @@ inline SceneConfig block_scene(int dim, Material material) {
     s.effects.push_back(Effect::plasticity);
     s.effects.push_back(Effect::softening);
   }
-  s.body = "box";
-  s.bed_shape = "flat";
+  s.body = Body::box;
+  s.bed_shape = BedShape::flat;
   s.flat_bed_z = 0.0;
-  s.initial_stress = "geostatic";
+  s.initial_stress = InitialStress::geostatic;
   s.settle_time = 0.0;
   s.dx = 1.0;
   s.particles_per_cell_axis = 2;

@@ -76,12 +76,12 @@ double ice_front_x(const Particles<Dim>& P, const SceneConfig& scene, double min
   for (std::size_t p = 0; p < P.size(); ++p)
     volume[static_cast<std::size_t>((P.x[p][0] - xmin) / dx)] += P.mass[p] / scene.density;
   double across = 1.0;  // 3D: the width of the ice across the flow
-  if constexpr (Dim == 3) across = scene.body == "slab" ? scene.width : scene.box_max[1] - scene.box_min[1];
-  const double thickness = scene.body == "slab" ? scene.ice_thickness : scene.box_max[Dim - 1] - scene.box_min[Dim - 1];
+  if constexpr (Dim == 3) across = scene.body == Body::slab ? scene.width : scene.box_max[1] - scene.box_min[1];
+  const double thickness = scene.body == Body::slab ? scene.ice_thickness : scene.box_max[Dim - 1] - scene.box_min[Dim - 1];
   const double full = min_fraction * thickness * dx * across;
   // Gaps upstream of the step top (a crack near the piston) do not end the ice: the walk
   // only stops at a gap downstream of it.
-  const double gaps_from_x = scene.body == "slab" ? scene.step_top_x() : xmin;
+  const double gaps_from_x = scene.body == Body::slab ? scene.step_top_x() : xmin;
   std::size_t last_thick = 0;
   int thin_run = 0;
   for (std::size_t c = 0; c < columns; ++c) {

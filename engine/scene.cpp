@@ -1,6 +1,8 @@
 #include "engine/scene.hpp"
 
 #include <algorithm>
+#include <functional>
+#include <type_traits>
 #include <cmath>
 #include <numbers>
 #include <set>
@@ -29,6 +31,16 @@ std::string fmt(double v) {
   std::ostringstream o;
   o << v;
   return o.str();
+}
+
+// A number as docs/scene_format.md writes it: 1e5 rather than 100000, − for minus.
+std::string doc_number(double v) {
+  const double a = std::abs(v);
+  std::string body;
+  const double e = a > 0 ? std::round(std::log10(a)) : 0;
+  if (a > 0 && std::abs(e) >= 3 && a == std::pow(10.0, e)) body = "1e" + std::to_string(static_cast<int>(e));
+  else body = fmt(a);
+  return (v < 0 ? "−" : "") + body;
 }
 
 [[noreturn]] void fail(const std::string& field, const std::string& what) {
@@ -111,6 +123,210 @@ class ObjectReader {
   std::set<std::string> used_;
 };
 
+template <class E>
+struct KindNames;
+template <>
+struct KindNames<Body> {
+  static constexpr std::pair<Body, const char*> names[] = {{Body::slab, "slab"}, {Body::box, "box"}};
+};
+template <>
+struct KindNames<BedShape> {
+  static constexpr std::pair<BedShape, const char*> names[] = {
+      {BedShape::step, "step"}, {BedShape::concave, "concave"}, {BedShape::flat, "flat"}, {BedShape::none, "none"}};
+};
+template <>
+struct KindNames<InitialStress> {
+  static constexpr std::pair<InitialStress, const char*> names[] = {{InitialStress::geostatic, "geostatic"},
+                                                                    {InitialStress::hydrostatic, "hydrostatic"},
+                                                                    {InitialStress::none, "none"}};
+};
+template <>
+struct KindNames<DriveStart> {
+  static constexpr std::pair<DriveStart, const char*> names[] = {{DriveStart::ramp, "ramp"},
+                                                                 {DriveStart::moving, "moving"}};
+};
+template <>
+struct KindNames<DriveBoundary> {
+  static constexpr std::pair<DriveBoundary, const char*> names[] = {{DriveBoundary::piston, "piston"},
+                                                                    {DriveBoundary::inflow, "inflow"}};
+};
+
+template <class E>
+const char* name_of(E k) {
+  for (const auto& [v, n] : KindNames<E>::names)
+    if (v == k) return n;
+  return "?";
+}
+
+// 'a', 'b' or 'c'
+template <class E>
+std::string allowed_names() {
+  std::string out;
+  const std::size_t n = std::size(KindNames<E>::names);
+  for (std::size_t i = 0; i < n; ++i) {
+    out += (i == 0 ? "" : i + 1 == n ? " or " : ", ");
+    out += std::string("'") + KindNames<E>::names[i].second + "'";
+  }
+  return out;
+}
+
+template <class E>
+E kind_from_name(const std::string& field, const std::string& name) {
+  for (const auto& [v, n] : KindNames<E>::names)
+    if (name == n) return v;
+  fail(field, "value '" + name + "' is not " + allowed_names<E>());
+}
+
+// When a field's static range is checked: always; for a slab; with the softening effect; or
+// never here, because its bounds depend on other fields (SceneConfig::resolve checks those).
+enum class When { always, slab, softening, in_resolve };
+enum class Part { physics, numerics, run, output };
+
+// One scene field, described once: where it lives in the JSON, its part, type, unit and range.
+// The reader, the writer and the range checks below loop over these; the test
+// SceneFields.DocsTableMatchesTheFieldTable holds docs/scene_format.md to them.
+struct FieldSpec {
+  std::string section;  // JSON object holding it: "ice", "ice.softening", "bed", ...
+  std::string key;
+  Part part;
+  std::string type;  // number, integer, boolean, string
+  std::string unit;  // as docs/scene_format.md writes it
+  When when = When::always;
+  double lo = 0, hi = 0;
+  bool lo_open = false, hi_open = false;
+  std::string derived;  // "0 → 5 H_i": what a default of 0 (or < 0) stands for, for the docs
+  std::function<nlohmann::json(const SceneConfig&)> get;
+  std::function<void(ObjectReader&, SceneConfig&)> read;
+  std::function<double(const SceneConfig&)> number;  // the value the range check reads
+  std::string path() const { return section + "." + key; }
+};
+
+template <class Owner>
+FieldSpec number_field(std::string section, std::string key, Part part, std::string unit, double Owner::*m,
+                       When when, double lo, double hi, bool lo_open = false, bool hi_open = false,
+                       std::string derived = "") {
+  FieldSpec f{std::move(section), key, part, "number", std::move(unit), when, lo, hi, lo_open, hi_open,
+              std::move(derived), {}, {}, {}};
+  f.get = [m](const SceneConfig& s) { return nlohmann::json(s.*m); };
+  f.read = [m, key](ObjectReader& r, SceneConfig& s) { r.number(key, s.*m); };
+  f.number = [m](const SceneConfig& s) { return s.*m; };
+  return f;
+}
+
+template <class T, class Owner>
+FieldSpec integer_field(std::string section, std::string key, Part part, T Owner::*m, When when, double lo,
+                        double hi) {
+  FieldSpec f{std::move(section), key, part, "integer", "–", when, lo, hi, false, false, "", {}, {}, {}};
+  f.get = [m](const SceneConfig& s) { return nlohmann::json(s.*m); };
+  f.read = [m, key, path = f.path()](ObjectReader& r, SceneConfig& s) {
+    std::int64_t v = static_cast<std::int64_t>(s.*m);
+    r.integer(key, v);
+    if constexpr (std::is_unsigned_v<T>) {
+      if (v < 0) fail(path, "must be ≥ 0");
+      s.*m = static_cast<T>(v);
+    } else if constexpr (std::is_same_v<T, int>) {
+      s.*m = static_cast<int>(std::clamp<std::int64_t>(v, -1, 1000));  // still refused by the range check
+    } else {
+      s.*m = v;
+    }
+  };
+  f.number = [m](const SceneConfig& s) { return static_cast<double>(s.*m); };
+  return f;
+}
+
+template <class Owner>
+FieldSpec boolean_field(std::string section, std::string key, Part part, bool Owner::*m) {
+  FieldSpec f{std::move(section), key, part, "boolean", "", When::in_resolve, 0, 0, false, false, "", {}, {}, {}};
+  f.get = [m](const SceneConfig& s) { return nlohmann::json(s.*m); };
+  f.read = [m, key](ObjectReader& r, SceneConfig& s) { r.boolean(key, s.*m); };
+  return f;
+}
+
+template <class E, class Owner>
+FieldSpec kind_field(std::string section, std::string key, Part part, E Owner::*m) {
+  FieldSpec f{std::move(section), key, part, "string", "", When::in_resolve, 0, 0, false, false, "", {}, {}, {}};
+  f.get = [m](const SceneConfig& s) { return nlohmann::json(name_of(s.*m)); };
+  f.read = [m, key, path = f.path()](ObjectReader& r, SceneConfig& s) {
+    std::string name = name_of(s.*m);
+    r.string(key, name);
+    s.*m = kind_from_name<E>(path, name);
+  };
+  return f;
+}
+
+const std::vector<FieldSpec>& field_table() {
+  using S = SceneConfig;
+  constexpr auto P = Part::physics, N = Part::numerics, R = Part::run, O = Part::output;
+  constexpr auto A = When::always, Sl = When::slab, So = When::softening, X = When::in_resolve;
+  static const std::vector<FieldSpec> table = {
+      kind_field("ice", "body", P, &S::body),
+      number_field("ice", "density", P, "kg/m³", &S::density, A, 1, 1e5),
+      number_field("ice", "youngs_modulus", P, "Pa", &S::youngs_modulus, A, 1e3, 1e13),
+      number_field("ice", "poisson_ratio", P, "–", &S::poisson_ratio, A, -1, 0.5, true, true),
+      number_field("ice", "tensile_strength", P, "Pa", &S::tensile_strength, A, 0, 1e10, true),
+      number_field("ice", "shear_strength", P, "Pa", &S::shear_strength, A, 0, 1e12, true),
+      number_field("ice", "thickness", P, "m", &S::ice_thickness, Sl, 0, 1e5, true),
+      number_field("ice", "upstream_length", P, "m", &S::upstream_length, X, 0, 0, false, false, "5 H_i"),
+      number_field("ice", "draped_length", P, "m", &S::draped_length, X, 0, 0),
+      number_field("ice", "width", P, "m", &S::width, X, 0, 0, false, false, "H_i"),
+      kind_field("ice", "initial_stress", P, &S::initial_stress),
+      number_field("ice", "settle_time", N, "s", &S::settle_time, X, 0, 1e6, false, false, "30 h/c_p"),
+      number_field("ice.softening", "zeta_ref", P, "–", &S::zeta_ref, So, 0, 1e9, true),
+      number_field("ice.softening", "dx_ref", P, "m", &S::dx_ref, So, 0, 1e4, true),
+      number_field("ice.softening", "zeta", P, "–", &S::softening_zeta, So, 0, 1e9, false, false, "derived"),
+      number_field("ice.softening", "fracture_energy", P, "J/m²", &S::fracture_energy, So, 0, 1e12, false, false,
+                   "derived"),
+      boolean_field("ice.softening", "damage_softens_shear", P, &S::damage_softens_shear),
+      number_field("ice.softening", "residual_friction", P, "–", &S::residual_friction, So, 0, 10),
+      kind_field("bed", "shape", P, &S::bed_shape),
+      number_field("bed", "step_height", P, "m", &S::step_height, Sl, 0, 1e5),
+      number_field("bed", "step_length", P, "m", &S::step_length, Sl, 0, 1e6),
+      number_field("bed", "downstream_length", P, "m", &S::downstream_length, X, 0, 0, false, false, "10 H_i"),
+      number_field("bed", "friction", P, "–", &S::bed_friction, A, 0, 10),
+      number_field("bed", "z", P, "m", &S::flat_bed_z, X, 0, 0),
+      number_field("drive", "speed", P, "m/s", &S::drive_speed, A, 0, 1e3),
+      number_field("drive", "ramp_time", P, "s", &S::drive_ramp_time, A, 0, 1e6, false, false, "100 L_up/c_p"),
+      kind_field("drive", "start", P, &S::drive_start),
+      kind_field("drive", "boundary", P, &S::drive_boundary),
+      number_field("gravity", "g", P, "m/s²", &S::gravity, A, 0, 1e3),
+      number_field("gravity", "tilt_deg", P, "°", &S::gravity_tilt_deg, A, -90, 90),
+      number_field("numerics", "dx", N, "m", &S::dx, A, 1e-3, 1e4),
+      integer_field("numerics", "particles_per_cell_axis", N, &S::particles_per_cell_axis, A, 1, 6),
+      number_field("numerics", "cfl", N, "–", &S::cfl, A, 0, 2, true),
+      number_field("numerics", "jitter", N, "–", &S::jitter, A, 0, 0.5),
+      integer_field("numerics", "seed", N, &S::seed, X, 0, 0),
+      number_field("numerics", "top_margin", N, "m", &S::top_margin, A, 0, 1e6, false, false, "0.5 H_i + 4 dx"),
+      boolean_field("numerics", "volumetric_averaging", N, &S::volumetric_averaging),
+      number_field("run", "end_time", R, "s", &S::end_time, A, 0, 1e9),
+      number_field("run", "front_past_step", R, "m", &S::front_past_step, A, 0, 1e9),
+      number_field("run", "gate_length", R, "m", &S::gate_length, X, 0, 1e9),
+      number_field("run", "gate_offset", R, "m", &S::gate_offset, X, 0, 0),
+      integer_field("run", "max_steps", R, &S::max_steps, X, 0, 0),
+      number_field("run", "wall_time_limit", O, "s", &S::wall_time_limit, A, 0, 1e9),
+      number_field("output", "vtu_interval", O, "s", &S::vtu_interval, A, 0, 1e9),
+      boolean_field("output", "png", O, &S::png),
+  };
+  return table;
+}
+
+// The static ranges of the fields checked `when`.
+void check_fields(const SceneConfig& s, When when) {
+  for (const auto& f : field_table())
+    if (f.when == when && f.number) check_range(f.path(), f.number(s), f.lo, f.hi, f.lo_open, f.hi_open);
+}
+
+// The JSON object at a section's path ("ice.softening" → j["ice"]["softening"]).
+nlohmann::json& section_of(nlohmann::json& j, const std::string& section) {
+  nlohmann::json* at = &j;
+  std::size_t from = 0;
+  while (true) {
+    const std::size_t dot = section.find('.', from);
+    at = &(*at)[section.substr(from, dot - from)];
+    if (dot == std::string::npos) return *at;
+    from = dot + 1;
+  }
+}
+
 }  // namespace
 
 const char* effect_name(Effect e) {
@@ -128,8 +344,15 @@ Effect effect_from_name(const std::string& name) {
 }
 
 bool SceneConfig::records_gate() const {
-  return body == "slab" && (bed_shape == "step" || bed_shape == "concave") && has(Effect::plasticity);
+  return body == Body::slab && (bed_shape == BedShape::step || bed_shape == BedShape::concave) &&
+         has(Effect::plasticity);
 }
+
+const char* kind_name(Body k) { return name_of(k); }
+const char* kind_name(BedShape k) { return name_of(k); }
+const char* kind_name(InitialStress k) { return name_of(k); }
+const char* kind_name(DriveStart k) { return name_of(k); }
+const char* kind_name(DriveBoundary k) { return name_of(k); }
 
 bool SceneConfig::has(Effect e) const {
   return std::find(effects.begin(), effects.end(), e) != effects.end();
@@ -141,13 +364,13 @@ double SceneConfig::p_wave_speed() const {
 }
 
 double SceneConfig::drive_velocity(double t) const {
-  if (drive_start == "moving") return drive_speed;
+  if (drive_start == DriveStart::moving) return drive_speed;
   if (t >= drive_ramp_time || drive_ramp_time <= 0) return drive_speed;
   return 0.5 * drive_speed * (1.0 - std::cos(std::numbers::pi * t / drive_ramp_time));
 }
 
 double SceneConfig::drive_position(double t) const {
-  const double T = drive_start == "moving" ? 0.0 : drive_ramp_time;
+  const double T = drive_start == DriveStart::moving ? 0.0 : drive_ramp_time;
   if (T <= 0) return drive_speed * t;
   const double tr = std::min(t, T);
   const double ramp = 0.5 * drive_speed * (tr - T / std::numbers::pi * std::sin(std::numbers::pi * tr / T));
@@ -165,49 +388,18 @@ void SceneConfig::resolve() {
     for (Effect e : effects)
       if (!seen.insert(e).second) fail("effects", std::string("'") + effect_name(e) + "' listed twice");
   }
-  check_range("ice.density", density, 1.0, 1e5);
-  check_range("ice.youngs_modulus", youngs_modulus, 1e3, 1e13);
-  check_range("ice.poisson_ratio", poisson_ratio, -1.0, 0.5, true, true);
-  check_range("ice.tensile_strength", tensile_strength, 0.0, 1e10, true);
-  check_range("ice.shear_strength", shear_strength, 0.0, 1e12, true);
-  check_range("numerics.dx", dx, 1e-3, 1e4);
-  if (particles_per_cell_axis < 1 || particles_per_cell_axis > 6)
-    fail("numerics.particles_per_cell_axis",
-         "value " + std::to_string(particles_per_cell_axis) + " is outside the allowed range [1, 6]");
-  check_range("numerics.cfl", cfl, 0.0, 2.0, true);
-  check_range("numerics.jitter", jitter, 0.0, 0.5);
-  check_range("numerics.top_margin", top_margin, 0.0, 1e6);
-  check_range("gravity.g", gravity, 0.0, 1e3);
-  check_range("gravity.tilt_deg", gravity_tilt_deg, -90.0, 90.0);
-  check_range("drive.speed", drive_speed, 0.0, 1e3);
-  check_range("drive.ramp_time", drive_ramp_time, 0.0, 1e6);
-  if (drive_start != "ramp" && drive_start != "moving")
-    fail("drive.start", "value '" + drive_start + "' is not 'ramp' or 'moving'");
-  if (drive_boundary != "piston" && drive_boundary != "inflow")
-    fail("drive.boundary", "value '" + drive_boundary + "' is not 'piston' or 'inflow'");
-  if (drive_boundary == "inflow" && (body != "slab" || !has(Effect::drive)))
+  check_fields(*this, When::always);
+  if (drive_boundary == DriveBoundary::inflow && (body != Body::slab || !has(Effect::drive)))
     fail("drive.boundary", "'inflow' needs ice.body 'slab' and the 'drive' effect");
-  check_range("bed.friction", bed_friction, 0.0, 10.0);
-  check_range("run.end_time", end_time, 0.0, 1e9);
-  check_range("run.front_past_step", front_past_step, 0.0, 1e9);
-  check_range("run.wall_time_limit", wall_time_limit, 0.0, 1e9);
-  check_range("output.vtu_interval", vtu_interval, 0.0, 1e9);
   if (max_steps < 0) fail("run.max_steps", "must be ≥ 0 (0 = unlimited)");
   if (end_time == 0 && front_past_step == 0 && gate_length == 0 && max_steps == 0)
     fail("run", "give end_time, front_past_step, gate_length or max_steps, or the run never stops");
   if (has(Effect::softening) && !has(Effect::plasticity))
     fail("effects", "'softening' needs 'plasticity'");
-  if (initial_stress != "geostatic" && initial_stress != "hydrostatic" && initial_stress != "none")
-    fail("ice.initial_stress",
-         "value '" + initial_stress + "' is not 'geostatic', 'hydrostatic' or 'none'");
 
   // ζ: explicit, from G, or crack-band scaled from the reference (docs/model.md).
   if (has(Effect::softening)) {
-    check_range("ice.softening.zeta", softening_zeta, 0.0, 1e9);
-    check_range("ice.softening.fracture_energy", fracture_energy, 0.0, 1e12);
-    check_range("ice.softening.zeta_ref", zeta_ref, 0.0, 1e9, true);
-    check_range("ice.softening.dx_ref", dx_ref, 0.0, 1e4, true);
-    check_range("ice.softening.residual_friction", residual_friction, 0.0, 10.0);
+    check_fields(*this, When::softening);
     // ζ from one source only: a scene written by scene_to_json carries the ζ its G implied,
     // which is accepted; a ζ that disagrees with G would be used while G was ignored.
     if (softening_zeta > 0.0 && fracture_energy > 0.0 &&
@@ -225,14 +417,13 @@ void SceneConfig::resolve() {
     softening_zeta = 0.0;
   }
 
-  if (body == "slab") check_range("ice.thickness", ice_thickness, 0.0, 1e5, true);
+  if (body == Body::slab) check_fields(*this, When::slab);
   if (settle_time < 0.0) {
-    const double h = body == "slab" ? ice_thickness : box_max[dim - 1] - box_min[dim - 1];
-    settle_time = (initial_stress != "none" && has(Effect::gravity)) ? 30.0 * h / p_wave_speed() : 0.0;
+    const double h = body == Body::slab ? ice_thickness : box_max[dim - 1] - box_min[dim - 1];
+    settle_time = (initial_stress != InitialStress::none && has(Effect::gravity)) ? 30.0 * h / p_wave_speed() : 0.0;
   }
   check_range("ice.settle_time", settle_time, 0.0, 1e6);
-  if (body == "slab") {
-    check_range("ice.thickness", ice_thickness, 0.0, 1e5, true);
+  if (body == Body::slab) {
     if (dx > ice_thickness / 4.0)
       fail("numerics.dx", "value " + fmt(dx) + " is too coarse for ice.thickness " +
                               fmt(ice_thickness) + " (need dx ≤ H_i/4 = " + fmt(ice_thickness / 4) + ")");
@@ -240,7 +431,7 @@ void SceneConfig::resolve() {
     if (downstream_length == 0.0) downstream_length = 10.0 * ice_thickness;
     if (width == 0.0) width = ice_thickness;
     if (top_margin == 0.0) top_margin = 0.5 * ice_thickness + 4.0 * dx;
-    if (drive_start == "moving") drive_ramp_time = 0.0;
+    if (drive_start == DriveStart::moving) drive_ramp_time = 0.0;
     else if (drive_ramp_time == 0.0 && has(Effect::drive)) drive_ramp_time = 100.0 * upstream_length / p_wave_speed();
     check_range("ice.upstream_length", upstream_length, 2.0 * dx, 1e7);
     // A glacier held downstream drapes the whole bed by default, up to the outflow line.
@@ -250,11 +441,9 @@ void SceneConfig::resolve() {
     check_range("ice.draped_length", draped_length, 0.0, step_length + downstream_length - 3.0 * dx);
     check_range("bed.downstream_length", downstream_length, 4.0 * dx, 1e7);
     check_range("ice.width", width, 2.0 * dx, 1e6);
-    check_range("bed.step_height", step_height, 0.0, 1e5);
-    check_range("bed.step_length", step_length, 0.0, 1e6);
-    if (bed_shape != "step" && bed_shape != "concave")
-      fail("bed.shape", "value '" + bed_shape + "' is not 'step' or 'concave' (body 'slab')");
-    if (bed_shape == "concave" && step_length <= 0)
+    if (bed_shape != BedShape::step && bed_shape != BedShape::concave)
+      fail("bed.shape", std::string("value '") + kind_name(bed_shape) + "' is not 'step' or 'concave' (body 'slab')");
+    if (bed_shape == BedShape::concave && step_length <= 0)
       fail("bed.step_length", "must be > 0 for the concave bed");
     const double x_end = upstream_length + step_length + downstream_length;
     domain_min = {-4.0 * dx, 0.0, -4.0 * dx};
@@ -263,7 +452,7 @@ void SceneConfig::resolve() {
       domain_min = {-4.0 * dx, -4.0 * dx, 0.0};
       domain_max = {x_end, step_height + ice_thickness + top_margin, 0.0};
     }
-  } else if (body == "box") {
+  } else {
     for (int a = 0; a < dim; ++a) {
       const std::string ax = std::to_string(a);
       if (!(box_max[a] > box_min[a])) fail("ice.box_max", "must exceed ice.box_min on axis " + ax);
@@ -271,21 +460,19 @@ void SceneConfig::resolve() {
       if (box_min[a] < domain_min[a] || box_max[a] > domain_max[a])
         fail("ice.box_min", "the ice box must lie inside the domain on axis " + ax);
     }
-    if (bed_shape != "flat" && bed_shape != "none")
-      fail("bed.shape", "value '" + bed_shape + "' is not 'flat' or 'none' (body 'box')");
-  } else {
-    fail("ice.body", "value '" + body + "' is not 'slab' or 'box'");
+    if (bed_shape != BedShape::flat && bed_shape != BedShape::none)
+      fail("bed.shape", std::string("value '") + kind_name(bed_shape) + "' is not 'flat' or 'none' (body 'box')");
   }
   check_range("run.gate_length", gate_length, 0.0, 1e9);
   if (gate_length != 0.0) {
     if (!records_gate())
       fail("run.gate_length", "needs a slab on a 'step' or 'concave' bed with the 'plasticity' effect");
     // A piston consumes the slab behind the step; an inflow feeds it without end.
-    if (drive_boundary == "piston") check_range("run.gate_length", gate_length, 0.0, upstream_length, true);
+    if (drive_boundary == DriveBoundary::piston) check_range("run.gate_length", gate_length, 0.0, upstream_length, true);
   }
-  check_range("run.gate_offset", gate_offset, 0.0, body == "slab" ? step_length + downstream_length - 8.0 * dx : 0.0);
+  check_range("run.gate_offset", gate_offset, 0.0, body == Body::slab ? step_length + downstream_length - 8.0 * dx : 0.0);
   if (has(Effect::downstream_drive)) {
-    if (body != "slab" || !has(Effect::drive) || !has(Effect::outflow))
+    if (body != Body::slab || !has(Effect::drive) || !has(Effect::outflow))
       fail("effects", "'downstream_drive' needs ice.body 'slab' and the 'drive' and 'outflow' effects");
     // The held cells are the last 5 before the domain's end (Simulation::kDownstreamDriveCells).
     const double reach = step_length + downstream_length - 5.0 * dx;
@@ -294,7 +481,7 @@ void SceneConfig::resolve() {
                                     "with 'downstream_drive' it must be at least bed.step_length + " +
                                     "bed.downstream_length - 5 dx = " + fmt(reach));
   }
-  if (has(Effect::basal_friction) && bed_shape == "none")
+  if (has(Effect::basal_friction) && bed_shape == BedShape::none)
     fail("bed.shape", "'basal_friction' needs a bed");
   for (int a : wall_axes)
     if (a < 0 || a >= dim) fail("domain.wall_axes", "axis " + std::to_string(a) + " is not in [0, dim)");
@@ -308,7 +495,7 @@ void SceneConfig::resolve() {
   for (int a = 0; a < dim; ++a) {
     if ((domain_max[a] - domain_min[a]) / dx > 1e6)
       fail("numerics.dx", "value " + fmt(dx) + " gives more than 1e6 cells along axis " + std::to_string(a));
-    const double ice = body == "box" ? box_max[a] - box_min[a]
+    const double ice = body == Body::box ? box_max[a] - box_min[a]
                        : a == 0      ? upstream_length + draped_length
                        : a == dim - 1 ? ice_thickness
                                       : width;
@@ -334,73 +521,29 @@ SceneConfig scene_from_json(const nlohmann::json& j) {
       s.effects.push_back(effect_from_name(name.get<std::string>()));
     }
   }
+  // The table's sections, each an object of its parent; "ice.softening" is read inside "ice".
+  const auto read_section = [&](ObjectReader& o, const std::string& section) {
+    for (const auto& f : field_table())
+      if (f.section == section) f.read(o, s);
+  };
   if (const auto* ice = r.child("ice")) {
     ObjectReader o(*ice, "ice");
-    o.number("density", s.density);
-    o.number("youngs_modulus", s.youngs_modulus);
-    o.number("poisson_ratio", s.poisson_ratio);
-    o.number("tensile_strength", s.tensile_strength);
-    o.number("shear_strength", s.shear_strength);
-    o.string("body", s.body);
-    o.number("thickness", s.ice_thickness);
-    o.number("upstream_length", s.upstream_length);
-    o.number("draped_length", s.draped_length);
-    o.number("width", s.width);
+    read_section(o, "ice");
     o.vector3("box_min", s.box_min, s.dim);
     o.vector3("box_max", s.box_max, s.dim);
-    o.string("initial_stress", s.initial_stress);
-    o.number("settle_time", s.settle_time);
     if (const auto* soft = o.child("softening")) {
       ObjectReader so(*soft, "ice.softening");
-      so.number("zeta_ref", s.zeta_ref);
-      so.number("dx_ref", s.dx_ref);
-      so.number("zeta", s.softening_zeta);
-      so.number("fracture_energy", s.fracture_energy);
-      so.boolean("damage_softens_shear", s.damage_softens_shear);
-      so.number("residual_friction", s.residual_friction);
+      read_section(so, "ice.softening");
       so.refuse_unknown();
     }
     o.refuse_unknown();
   }
-  if (const auto* bed = r.child("bed")) {
-    ObjectReader o(*bed, "bed");
-    o.string("shape", s.bed_shape);
-    o.number("step_height", s.step_height);
-    o.number("step_length", s.step_length);
-    o.number("downstream_length", s.downstream_length);
-    o.number("friction", s.bed_friction);
-    o.number("z", s.flat_bed_z);
-    o.refuse_unknown();
-  }
-  if (const auto* d = r.child("drive")) {
-    ObjectReader o(*d, "drive");
-    o.number("speed", s.drive_speed);
-    o.number("ramp_time", s.drive_ramp_time);
-    o.string("start", s.drive_start);
-    o.string("boundary", s.drive_boundary);
-    o.refuse_unknown();
-  }
-  if (const auto* g = r.child("gravity")) {
-    ObjectReader o(*g, "gravity");
-    o.number("g", s.gravity);
-    o.number("tilt_deg", s.gravity_tilt_deg);
-    o.refuse_unknown();
-  }
-  if (const auto* n = r.child("numerics")) {
-    ObjectReader o(*n, "numerics");
-    o.number("dx", s.dx);
-    std::int64_t ppc = s.particles_per_cell_axis;
-    o.integer("particles_per_cell_axis", ppc);
-    s.particles_per_cell_axis = static_cast<int>(std::clamp<std::int64_t>(ppc, -1, 1000));
-    o.number("cfl", s.cfl);
-    o.number("jitter", s.jitter);
-    std::int64_t seed = static_cast<std::int64_t>(s.seed);
-    o.integer("seed", seed);
-    if (seed < 0) fail("numerics.seed", "must be ≥ 0");
-    s.seed = static_cast<std::uint64_t>(seed);
-    o.number("top_margin", s.top_margin);
-    o.boolean("volumetric_averaging", s.volumetric_averaging);
-    o.refuse_unknown();
+  for (const char* section : {"bed", "drive", "gravity", "numerics", "run", "output"}) {
+    if (const auto* obj = r.child(section)) {
+      ObjectReader o(*obj, section);
+      read_section(o, section);
+      o.refuse_unknown();
+    }
   }
   if (const auto* d = r.child("domain")) {
     ObjectReader o(*d, "domain");
@@ -432,28 +575,16 @@ SceneConfig scene_from_json(const nlohmann::json& j) {
       s.velocity_boxes.push_back(b);
     }
   }
-  if (const auto* run = r.child("run")) {
-    ObjectReader o(*run, "run");
-    o.number("end_time", s.end_time);
-    o.number("front_past_step", s.front_past_step);
-    o.number("gate_length", s.gate_length);
-    o.number("gate_offset", s.gate_offset);
-    o.integer("max_steps", s.max_steps);
-    o.number("wall_time_limit", s.wall_time_limit);
-    o.refuse_unknown();
-  }
-  if (const auto* out = r.child("output")) {
-    ObjectReader o(*out, "output");
-    o.number("vtu_interval", s.vtu_interval);
-    o.boolean("png", s.png);
-    o.refuse_unknown();
-  }
   r.refuse_unknown();
   s.resolve();
   return s;
 }
 
-nlohmann::json scene_to_json(const SceneConfig& s) {
+namespace {
+
+// The canonical JSON of the fields of the given parts, and of the fields outside the table
+// (dim, effects, the box, the domain and the velocity boxes, all physics).
+nlohmann::json scene_json_of(const SceneConfig& s, std::initializer_list<Part> parts) {
   using nlohmann::json;
   auto vec = [&](const std::array<double, 3>& v) {
     json a = json::array();
@@ -462,57 +593,10 @@ nlohmann::json scene_to_json(const SceneConfig& s) {
   };
   json effects = json::array();
   for (Effect e : s.effects) effects.push_back(effect_name(e));
-  json j = {
-      {"name", s.name},
-      {"dim", s.dim},
-      {"effects", effects},
-      {"ice",
-       {{"density", s.density},
-        {"youngs_modulus", s.youngs_modulus},
-        {"poisson_ratio", s.poisson_ratio},
-        {"tensile_strength", s.tensile_strength},
-        {"shear_strength", s.shear_strength},
-        {"body", s.body},
-        {"thickness", s.ice_thickness},
-        {"upstream_length", s.upstream_length},
-        {"draped_length", s.draped_length},
-        {"width", s.width},
-        {"initial_stress", s.initial_stress},
-        {"settle_time", s.settle_time},
-        {"softening",
-         {{"zeta_ref", s.zeta_ref},
-          {"dx_ref", s.dx_ref},
-          {"zeta", s.softening_zeta},
-          {"fracture_energy", s.fracture_energy},
-          {"damage_softens_shear", s.damage_softens_shear},
-          {"residual_friction", s.residual_friction}}}}},
-      {"bed",
-       {{"shape", s.bed_shape},
-        {"step_height", s.step_height},
-        {"step_length", s.step_length},
-        {"downstream_length", s.downstream_length},
-        {"friction", s.bed_friction},
-        {"z", s.flat_bed_z}}},
-      {"drive", {{"speed", s.drive_speed}, {"ramp_time", s.drive_ramp_time}, {"start", s.drive_start}, {"boundary", s.drive_boundary}}},
-      {"gravity", {{"g", s.gravity}, {"tilt_deg", s.gravity_tilt_deg}}},
-      {"numerics",
-       {{"dx", s.dx},
-        {"particles_per_cell_axis", s.particles_per_cell_axis},
-        {"cfl", s.cfl},
-        {"jitter", s.jitter},
-        {"seed", s.seed},
-        {"top_margin", s.top_margin},
-        {"volumetric_averaging", s.volumetric_averaging}}},
-      {"run",
-       {{"end_time", s.end_time},
-        {"front_past_step", s.front_past_step},
-        {"gate_length", s.gate_length},
-        {"gate_offset", s.gate_offset},
-        {"max_steps", s.max_steps},
-        {"wall_time_limit", s.wall_time_limit}}},
-      {"output", {{"vtu_interval", s.vtu_interval}, {"png", s.png}}},
-  };
-  if (s.body == "box") {
+  json j = {{"dim", s.dim}, {"effects", effects}};
+  for (const auto& f : field_table())
+    if (std::find(parts.begin(), parts.end(), f.part) != parts.end()) section_of(j, f.section)[f.key] = f.get(s);
+  if (s.body == Body::box) {
     j["ice"]["box_min"] = vec(s.box_min);
     j["ice"]["box_max"] = vec(s.box_max);
     j["domain"] = {{"min", vec(s.domain_min)}, {"max", vec(s.domain_max)}, {"wall_axes", s.wall_axes}};
@@ -526,6 +610,34 @@ nlohmann::json scene_to_json(const SceneConfig& s) {
     j["velocity_boxes"] = vb;
   }
   return j;
+}
+
+}  // namespace
+
+nlohmann::json scene_to_json(const SceneConfig& s) {
+  nlohmann::json j = scene_json_of(s, {Part::physics, Part::numerics, Part::run, Part::output});
+  j["name"] = s.name;
+  return j;
+}
+
+nlohmann::json scene_results_json(const SceneConfig& s) {
+  return scene_json_of(s, {Part::physics, Part::numerics, Part::run});
+}
+
+std::vector<SceneFieldDoc> scene_field_docs() {
+  std::vector<SceneFieldDoc> out;
+  const SceneConfig defaults;
+  for (const auto& f : field_table()) {
+    SceneFieldDoc d{f.path(), f.type, f.unit, "", ""};
+    const nlohmann::json v = f.get(defaults);
+    d.default_value = v.is_string() ? "`\"" + v.get<std::string>() + "\"`" : v.is_boolean() ? v.dump() : doc_number(v.get<double>());
+    if (!f.derived.empty()) d.default_value += " → " + f.derived;
+    if (f.number && f.when != When::in_resolve) {
+      d.range = std::string(f.lo_open ? "(" : "[") + doc_number(f.lo) + ", " + doc_number(f.hi) + (f.hi_open ? ")" : "]");
+    }
+    out.push_back(std::move(d));
+  }
+  return out;
 }
 
 }  // namespace crevasse

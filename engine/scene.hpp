@@ -32,12 +32,37 @@ struct VelocityBox {
   std::array<double, 3> velocity{};     // [m/s]; the box moves with it
 };
 
-struct SceneConfig {
-  std::string name = "scene";
+// The kinds a scene chooses between (JSON strings in scene files; kind_name gives them).
+enum class Body { slab, box };  // glacier on the plateau; or a box of ice box_min..box_max
+enum class BedShape { step, concave, flat, none };
+// "geostatic": σ_zz = −ρ g (s − z), lateral K0 σ_zz; "hydrostatic": K0 = 1; "none": unloaded.
+enum class InitialStress { geostatic, hydrostatic, none };
+// How the glacier starts. ramp: at rest, the drive accelerating over drive_ramp_time. moving:
+// once settled, the glacier slides as a rigid body at V_x and the drives run at V_x from t = 0:
+// no ramp at all, so nothing in the start grows with the slab's length.
+enum class DriveStart { ramp, moving };
+// What drives the glacier at its back. piston: the back layer of the slab is pushed at V_x, so
+// the slab behind the step is consumed and the push grows with its length. inflow: the grid
+// nodes at the back of the domain move at V_x and ice enters there, a copy of the ice just
+// inside (Simulation::inflow), so the upstream ice is only as long as upstream_length.
+enum class DriveBoundary { piston, inflow };
+const char* kind_name(Body k);
+const char* kind_name(BedShape k);
+const char* kind_name(InitialStress k);
+const char* kind_name(DriveStart k);
+const char* kind_name(DriveBoundary k);
+
+// A scene in four parts. The first three decide what a run computes (the case hash is taken
+// over them, engine/scene.cpp); the output part only what it writes and how long it may take.
+// docs/scene_format.md is the reference of every field (JSON path, unit, default, range); the
+// field table in engine/scene.cpp reads, writes and checks them, and a test holds the two equal.
+
+// The model: the ice, the bed, the drive, gravity, and the effects the step runs.
+struct ScenePhysics {
   int dim = 2;
   std::vector<Effect> effects;
 
-  // Ice (docs/model.md defaults)
+  // Ice
   double density = 917.0;             // ρ_i [kg/m³]
   double youngs_modulus = 1.0e9;      // E [Pa]
   double poisson_ratio = 0.3;         // ν [-]
@@ -53,7 +78,7 @@ struct SceneConfig {
   double residual_friction = 1.2;     // M: damaged ice keeps q ≤ M·p (rubble, φ ≈ 30°)
 
   // Geometry
-  std::string body = "slab";          // "slab": glacier on the plateau; "box": box_min..box_max
+  Body body = Body::slab;
   double ice_thickness = 100.0;       // H_i [m]
   double upstream_length = 0.0;       // slab length on the plateau [m]; 0 → 5·H_i
   // Ice already draped over the bed past the top of the step, horizontal length [m]: the
@@ -61,22 +86,16 @@ struct SceneConfig {
   // slab ends in a cliff at the top of the step (docs/model.md).
   double draped_length = 0.0;
   double width = 0.0;                 // W_i [m] (3D); 0 → H_i
-  std::array<double, 3> box_min{}, box_max{};  // body "box" extent [m]
-  std::string initial_stress = "geostatic";    // "geostatic", "hydrostatic" or "none"
-  // Settling: the discrete MPM equilibrium differs slightly from the analytic geostatic state,
-  // so an undamped start rings and puts the top particle layer into tension. Before t = 0 the
-  // slab settles elastically (no return mapping, so no plastic strain), with the drive at rest
-  // and its grid velocity damped at rate γ = c_p/H_i (near-critical for the slab's first
-  // vertical mode), for settle_time; then velocities are zeroed and the clock starts.
-  double settle_time = -1.0;          // [s]; < 0 → 30·H_i/c_p with geostatic stress, 0 = none
+  std::array<double, 3> box_min{}, box_max{};  // body box extent [m]
+  InitialStress initial_stress = InitialStress::geostatic;
 
   // Bed
-  std::string bed_shape = "step";     // "step", "concave", "flat", "none"
+  BedShape bed_shape = BedShape::step;
   double step_height = 100.0;         // H_s [m]
   double step_length = 100.0;         // L_s [m]; 0 = vertical step
   double downstream_length = 0.0;     // floor length past the step [m]; 0 → 10·H_i
   double bed_friction = 0.1;          // μ_b [-]
-  double flat_bed_z = 0.0;            // bed "flat": its height [m]
+  double flat_bed_z = 0.0;            // bed flat: its height [m]
 
   double drive_speed = 4.0;           // V_x [m/s]
   // The piston accelerates smoothly, v = V_x (1 − cos(π t/T))/2 for t < T: an impulsive start
@@ -84,19 +103,19 @@ struct SceneConfig {
   // longer than the slab's first period 4 L_up/c_p makes the start quasi-static: the inertial
   // compression ρ L_up V_x π/(2T) is then ~70 kPa and the ringing negligible. 0 → 100 L_up/c_p.
   double drive_ramp_time = 0.0;       // T [s]
-  // How the glacier starts. "ramp": at rest, the drive accelerating over drive_ramp_time.
-  // "moving": once settled, the glacier slides as a rigid body at V_x and the drives run at V_x
-  // from t = 0: no ramp at all, so nothing in the start grows with the slab's length.
-  std::string drive_start = "ramp";
-  // What drives the glacier at its back. "piston": the back layer of the slab is pushed at V_x,
-  // so the slab behind the step is consumed and the push grows with its length. "inflow": the
-  // grid nodes at the back of the domain move at V_x and ice enters there, a copy of the ice
-  // just inside (Simulation::inflow), so the upstream ice is only as long as upstream_length.
-  std::string drive_boundary = "piston";
+  DriveStart drive_start = DriveStart::ramp;
+  DriveBoundary drive_boundary = DriveBoundary::piston;
   double gravity = 9.81;              // g [m/s²]
   double gravity_tilt_deg = 0.0;      // tilt of gravity towards +x (incline tests) [deg]
 
-  // Numerics
+  // Boundaries of box scenes
+  std::array<double, 3> domain_min{}, domain_max{};  // body box: explicit domain [m] (slab: derived)
+  std::vector<int> wall_axes;         // box_walls: axes with free-slip walls on both faces
+  std::vector<VelocityBox> velocity_boxes;
+};
+
+// The discretisation and the start-up procedure.
+struct SceneNumerics {
   double dx = 10.0;                   // grid spacing [m]
   int particles_per_cell_axis = 2;    // 2 → 4 per cell in 2D, 8 in 3D
   double cfl = 0.5;                   // dt = cfl·dx/(c_p + max|v|)
@@ -107,11 +126,16 @@ struct SceneConfig {
   // update, which removes the particle-scale pressure checkerboard that quadratic MLS-MPM
   // builds near concentrated loads (the lip of the step) and that cracks the ice spuriously.
   bool volumetric_averaging = true;
-  std::array<double, 3> domain_min{}, domain_max{};  // body "box": explicit domain [m]
-  std::vector<int> wall_axes;         // box_walls: axes with free-slip walls on both faces
-  std::vector<VelocityBox> velocity_boxes;
+  // Settling: the discrete MPM equilibrium differs slightly from the analytic geostatic state,
+  // so an undamped start rings and puts the top particle layer into tension. Before t = 0 the
+  // slab settles elastically (no return mapping, so no plastic strain), with the drive at rest
+  // and its grid velocity damped at rate γ = c_p/H_i (near-critical for the slab's first
+  // vertical mode), for settle_time; then velocities are zeroed and the clock starts.
+  double settle_time = -1.0;          // [s]; < 0 → 30·H_i/c_p with geostatic stress, 0 = none
+};
 
-  // Run control
+// When the run stops (the measurement's window depends on it).
+struct SceneRun {
   double end_time = 0.0;              // [s]; 0 → until front_past_step
   double front_past_step = 0.0;       // stop when the front is this far past the step foot [m]
   // Stop once this much ice, as a length along flow, has passed the measurement gate at the top
@@ -122,11 +146,17 @@ struct SceneConfig {
   // as it bends over the lip, so its crevasses are recorded a little way down the ramp.
   double gate_offset = 0.0;
   std::int64_t max_steps = 0;         // 0 = unlimited
-  double wall_time_limit = 0.0;       // [s]; 0 = unlimited
+};
 
-  // Output (crevasse run)
+// What a run writes and how long it may take: none of it changes a result.
+struct SceneOutput {
+  double wall_time_limit = 0.0;       // [s]; 0 = unlimited
   double vtu_interval = 0.0;          // simulated seconds between VTU snapshots; 0 = none
   bool png = true;                    // side view at the end
+};
+
+struct SceneConfig : ScenePhysics, SceneNumerics, SceneRun, SceneOutput {
+  std::string name = "scene";
 
   bool has(Effect e) const;
   // Fills derived values (lengths defaulting to multiples of H_i, ζ from dx, the domain) and
@@ -147,5 +177,16 @@ struct SceneConfig {
 
 SceneConfig scene_from_json(const nlohmann::json& j);  // resolve()d; throws InputError
 nlohmann::json scene_to_json(const SceneConfig& s);    // canonical, every field explicit
+// The parts that decide what a run computes (all but the name and SceneOutput): what a case's
+// identity, and so its hash, is taken over.
+nlohmann::json scene_results_json(const SceneConfig& s);
+
+// One row of the field table, as docs/scene_format.md shows it (the test that holds the docs to
+// the table reads these): JSON path, type, unit, default (with what a 0 default stands for) and
+// the static range ("" when the range depends on other fields; the docs then say how).
+struct SceneFieldDoc {
+  std::string path, type, unit, default_value, range;
+};
+std::vector<SceneFieldDoc> scene_field_docs();
 
 }  // namespace crevasse

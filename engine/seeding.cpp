@@ -18,8 +18,8 @@ Particles<Dim> seed_ice(const SceneConfig& scene, const ElasticModuli& moduli, c
   Vec<Dim> lo, hi;
   double surface_z;
   // Draped ice: the slab continues past the top of the step between the bed and z_b + H_i.
-  const bool draped = scene.body == "slab" && scene.draped_length > 0.0 && bed != nullptr;
-  if (scene.body == "slab") {
+  const bool draped = scene.body == Body::slab && scene.draped_length > 0.0 && bed != nullptr;
+  if (scene.body == Body::slab) {
     lo.setZero();
     hi.setZero();
     lo[0] = 0.0;
@@ -47,9 +47,9 @@ Particles<Dim> seed_ice(const SceneConfig& scene, const ElasticModuli& moduli, c
   // is of order 1e-3, so the second pass already changes τ by ~1e-6 relative).
   // "hydrostatic" (K0 = 1) is the cryostatic state of ice that has flowed long enough for its
   // deviatoric stress to relax: no shear stress at rest, so a low q_y does not yield at t = 0.
-  const bool prestressed = scene.initial_stress != "none" && scene.has(Effect::gravity);
+  const bool prestressed = scene.initial_stress != InitialStress::none && scene.has(Effect::gravity);
   const double g_vertical = scene.gravity * std::cos(scene.gravity_tilt_deg * std::numbers::pi / 180.0);
-  const double k0 = scene.initial_stress == "hydrostatic" ? 1.0 : scene.poisson_ratio / (1.0 - scene.poisson_ratio);
+  const double k0 = scene.initial_stress == InitialStress::hydrostatic ? 1.0 : scene.poisson_ratio / (1.0 - scene.poisson_ratio);
   const double cell_volume = std::pow(h, Dim);
 
   std::size_t total = 1;
@@ -92,7 +92,7 @@ Particles<Dim> seed_ice(const SceneConfig& scene, const ElasticModuli& moduli, c
   }
   particles.shrink_to_fit();
   if (scene.has(Effect::plasticity)) particles.eps_v_p.assign(particles.size(), 0.0);
-  if (scene.has(Effect::drive) && scene.drive_boundary == "piston") {
+  if (scene.has(Effect::drive) && scene.drive_boundary == DriveBoundary::piston) {
     particles.drive_x0.assign(particles.size(), std::numeric_limits<double>::quiet_NaN());
     for (std::size_t p = 0; p < particles.size(); ++p)
       if (particles.x[p][0] < lo[0] + dx) particles.drive_x0[p] = particles.x[p][0];

@@ -54,17 +54,17 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   domain_hi_ = to_vec<Dim>(scene_.domain_max);
 
   const double x_lo = scene_.domain_min[0], x_hi = scene_.domain_max[0];
-  if (scene_.bed_shape == "step") {
+  if (scene_.bed_shape == BedShape::step) {
     bed_ = Bed::step(scene_.step_top_x(), scene_.step_height, scene_.step_length, x_lo, x_hi);
-  } else if (scene_.bed_shape == "concave") {
+  } else if (scene_.bed_shape == BedShape::concave) {
     bed_ = Bed::concave(scene_.step_top_x(), scene_.step_height, scene_.step_length, x_lo, x_hi);
-  } else if (scene_.bed_shape == "flat") {
+  } else if (scene_.bed_shape == BedShape::flat) {
     bed_ = Bed::flat(scene_.flat_bed_z, x_lo, x_hi);
   }
   if (bed_) bed_field_ = BedField<Dim>(*bed_, domain_lo_, domain_hi_, scene_.dx);
   particles_ = seed_ice<Dim>(scene_, moduli_, bed_ ? &*bed_ : nullptr);
   if (scene_.records_gate()) gate_ = GateRecorder<Dim>(particles_, scene_.gate_x());
-  if (scene_.body == "slab" && scene_.has(Effect::gravity)) {
+  if (scene_.body == Body::slab && scene_.has(Effect::gravity)) {
     // No particle of a slab can go faster than free fall from the top of the ice to the floor
     // plus twice the drive (a block pushed off at V_x and rebounding); 1.5× that is a margin
     // that the hard-case suite never approached in stable runs (docs/reliability.md).
@@ -84,7 +84,7 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   add_stage("p2g", [this] { particle_to_grid(); });
   add_stage(g != 0.0 ? "grid_velocity_gravity" : "grid_velocity",
             [this, gravity] { grid_velocity(gravity); });
-  const bool has_inflow = scene_.drive_boundary == "inflow";
+  const bool has_inflow = scene_.drive_boundary == DriveBoundary::inflow;
   constexpr double kInfinity = std::numeric_limits<double>::infinity();
   if (scene_.has(Effect::drive) && !has_inflow) {
     add_stage("drive_grid", [this] { pull_nodes_with_piston(grid_, particles_, drive_speed_now(), drive_node_mass_); });
@@ -120,7 +120,7 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   if (scene_.settle_time > 0.0) {
     // Damping exists only while settling: one branch per step, none per particle.
     settle_damping_rate_ = scene_.p_wave_speed() /
-                           (scene_.body == "slab" ? scene_.ice_thickness
+                           (scene_.body == Body::slab ? scene_.ice_thickness
                                                   : scene_.box_max[Dim - 1] - scene_.box_min[Dim - 1]);
     add_stage("settle_damping", [this] {
       if (!settling_) return;
@@ -183,7 +183,7 @@ void Simulation<Dim>::settle() {
     particles_.v[p].setZero();
     particles_.C[p].setZero();
   }
-  if (scene_.drive_start == "moving") start_moving();
+  if (scene_.drive_start == DriveStart::moving) start_moving();
   time_ = 0.0;
   steps_ = 0;
   particle_steps_ = 0;

@@ -115,11 +115,9 @@ std::string sha256_hex(const std::string& text) {
 
 nlohmann::json case_identity(const SceneConfig& scene, const nlohmann::json& measurement_settings,
                              const std::string& engine_version) {
-  nlohmann::json s = scene_to_json(scene);
-  s.erase("name");
-  s.erase("output");
-  if (s.contains("run")) s["run"].erase("wall_time_limit");
-  return {{"engine_version", engine_version}, {"scene", s}, {"measurement", measurement_settings}};
+  return {{"engine_version", engine_version},
+          {"scene", scene_results_json(scene)},
+          {"measurement", measurement_settings}};
 }
 
 std::string case_hash(const SceneConfig& scene, const nlohmann::json& measurement_settings,

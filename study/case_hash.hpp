@@ -13,9 +13,10 @@ namespace crevasse {
 // Lower-case hex SHA-256 (FIPS 180-4) of the bytes of `text`.
 std::string sha256_hex(const std::string& text);
 
-// What identifies a case: the resolved scene without the fields that cannot change a result
-// (name, output, run.wall_time_limit), the resolved measurement settings, and the engine
-// version. nlohmann::json keeps object keys sorted, so the dump is canonical.
+// What identifies a case: the parts of the resolved scene that decide the result
+// (scene_results_json: all but the name and the output part), the resolved measurement
+// settings, and the engine version. nlohmann::json keeps object keys sorted, so the dump is
+// canonical.
 nlohmann::json case_identity(const SceneConfig& scene, const nlohmann::json& measurement_settings,
                              const std::string& engine_version = CREVASSE_ENGINE_VERSION);
 

@@ -52,7 +52,7 @@ void check_scene_json(const nlohmann::json& j, const SceneConfig& s) {
                                  "they would be ignored; add the effect or remove the boxes");
   if (s.has(Effect::velocity_boundaries) && s.velocity_boxes.empty())
     refuse("effects", "'velocity_boundaries' needs at least one entry in velocity_boxes");
-  if (s.body == "slab") {
+  if (s.body == Body::slab) {
     for (const char* key : {"min", "max"})
       if (given(j, "domain", key))
         refuse(std::string("domain.") + key,
@@ -64,22 +64,22 @@ void check_scene_json(const nlohmann::json& j, const SceneConfig& s) {
                                "ignored; add the effect or remove wall_axes");
   if (s.has(Effect::box_walls) && s.wall_axes.empty())
     refuse("effects", "'box_walls' needs at least one axis in domain.wall_axes");
-  if (s.bed_shape != "flat" && given(j, "bed", "z") && s.flat_bed_z != 0.0)
-    refuse("bed.z", "value " + fmt(s.flat_bed_z) + " given for bed.shape '" + s.bed_shape +
+  if (s.bed_shape != BedShape::flat && given(j, "bed", "z") && s.flat_bed_z != 0.0)
+    refuse("bed.z", "value " + fmt(s.flat_bed_z) + " given for bed.shape '" + kind_name(s.bed_shape) +
                         "'; bed.z applies to bed.shape 'flat' only (remove it)");
 
   // Coordinates without a range check in the engine's loader. Lattice indices are ints: every
   // coordinate stays within 1e6 cells of 0, the limit resolve() puts on a domain's extent.
   const double reach = 1e6 * s.dx;
-  if (s.body == "box") {
+  if (s.body == Body::box) {
     for (int a = 0; a < s.dim; ++a) {
       check_range("domain.min[" + std::to_string(a) + "]", s.domain_min[a], -reach, reach);
       check_range("domain.max[" + std::to_string(a) + "]", s.domain_max[a], -reach, reach);
     }
   }
-  if (s.bed_shape == "flat") {
+  if (s.bed_shape == BedShape::flat) {
     // The flat bed lies inside the domain and under the ice, not through it.
-    const double top = s.body == "box" ? s.box_min[z] : s.domain_max[z];
+    const double top = s.body == Body::box ? s.box_min[z] : s.domain_max[z];
     check_range("bed.z", s.flat_bed_z, s.domain_min[z], top);
   }
   for (std::size_t i = 0; i < s.velocity_boxes.size(); ++i) {

@@ -38,13 +38,13 @@ inline SceneConfig box_scene(int dim, std::array<double, 3> lo, std::array<doubl
   s.name = "test_box";
   s.dim = dim;
   s.effects = effects;
-  s.body = "box";
+  s.body = Body::box;
   s.box_min = lo;
   s.box_max = hi;
   s.domain_min = domain_lo;
   s.domain_max = domain_hi;
-  s.bed_shape = "none";
-  s.initial_stress = "none";
+  s.bed_shape = BedShape::none;
+  s.initial_stress = InitialStress::none;
   s.density = kRho;
   s.youngs_modulus = kYoung;
   s.poisson_ratio = kPoisson;
@@ -81,8 +81,8 @@ inline SceneConfig small_glacier_scene(const SmallGlacier& g) {
   s.effects = {Effect::gravity, Effect::drive, Effect::basal_friction, Effect::plasticity,
                Effect::softening, Effect::outflow};
   if (g.dim == 3) s.effects.push_back(Effect::lateral_walls);
-  s.body = "slab";
-  s.initial_stress = "geostatic";
+  s.body = Body::slab;
+  s.initial_stress = InitialStress::geostatic;
   s.density = kRho;
   s.youngs_modulus = kYoung;
   s.poisson_ratio = kPoisson;
@@ -91,7 +91,7 @@ inline SceneConfig small_glacier_scene(const SmallGlacier& g) {
   s.upstream_length = g.upstream_ratio * g.thickness;
   s.width = g.width_ratio * g.thickness;
   s.tensile_strength = g.cohesion_ratio * kRho * kG * g.thickness;
-  s.bed_shape = "step";
+  s.bed_shape = BedShape::step;
   s.step_height = g.step_height_ratio * g.thickness;
   s.step_length = g.step_length_ratio * g.thickness;
   s.downstream_length = g.downstream_ratio * g.thickness;

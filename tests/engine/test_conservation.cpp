@@ -37,7 +37,7 @@ void check_mass_exact() {
                             {Effect::gravity, Effect::basal_friction, Effect::box_walls,
                              Effect::plasticity, Effect::softening},
                             1.0);
-  s.bed_shape = "flat";
+  s.bed_shape = BedShape::flat;
   s.wall_axes = walls;
   s.tensile_strength = 1.0e4;
   s.shear_strength = 5.0e4;

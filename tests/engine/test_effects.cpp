@@ -18,7 +18,7 @@ using test::has_stage;
 
 SceneConfig block(std::initializer_list<Effect> effects) {
   SceneConfig s = box_scene(2, {0, 0, 0}, {6, 3, 0}, {0, -3, 0}, {6, 8, 0}, effects, 1.0);
-  s.bed_shape = "flat";
+  s.bed_shape = BedShape::flat;
   s.wall_axes = {0};
   return finish(s);
 }
@@ -136,7 +136,7 @@ TEST(Effects, DriveStorageOnlyWithDrive) {
 // Settling runs only for a geostatic start under gravity, and its damping stage only then.
 TEST(Effects, SettlingOnlyForGeostaticStartUnderGravity) {
   SceneConfig geo = block({Effect::gravity, Effect::basal_friction});
-  geo.initial_stress = "geostatic";
+  geo.initial_stress = InitialStress::geostatic;
   geo.settle_time = -1.0;
   geo = finish(geo);
   EXPECT_GT(geo.settle_time, 0.0);

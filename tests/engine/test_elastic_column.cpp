@@ -49,7 +49,7 @@ SceneConfig column_scene(int dim) {
   }
   SceneConfig s = box_scene(dim, lo, hi, dlo, dhi,
                             {Effect::gravity, Effect::basal_friction, Effect::box_walls}, kDx);
-  s.bed_shape = "flat";
+  s.bed_shape = BedShape::flat;
   s.flat_bed_z = 0.0;
   s.bed_friction = 0.0;
   s.wall_axes = walls;
@@ -130,7 +130,7 @@ void check_no_plastic_strain_at_start() {
   SceneConfig s = column_scene(Dim);
   s.effects = {Effect::gravity, Effect::basal_friction, Effect::box_walls, Effect::plasticity,
                Effect::softening};
-  s.initial_stress = "geostatic";
+  s.initial_stress = InitialStress::geostatic;
   // c = 20 kPa: about a tenth of the overburden ρ g H ≈ 180 kPa, so a column that rang after
   // settling, or started far from equilibrium, would crack; yet far above the settled noise.
   s.tensile_strength = 2.0e4;

@@ -35,11 +35,11 @@ SceneConfig incline_scene(double theta_deg, double mu) {
   SceneConfig s =
       box_scene(Dim, {2.0, 0.0, 0.0}, hi, dlo, dhi, {Effect::gravity, Effect::basal_friction}, kDx);
   s.box_max[0] = 18.0;
-  s.bed_shape = "flat";
+  s.bed_shape = BedShape::flat;
   s.flat_bed_z = 0.0;
   s.bed_friction = mu;
   s.gravity_tilt_deg = theta_deg;
-  s.initial_stress = "geostatic";
+  s.initial_stress = InitialStress::geostatic;
   return finish(s);
 }
 
@@ -133,7 +133,7 @@ namespace {
 TEST(BedContact, BlockDroppedFromAboveTheBedTableFallsFreelyAndStopsAtTheBed) {
   SceneConfig s = test::box_scene(2, {10.0, 36.0, 0.0}, {18.0, 40.0, 0.0}, {0.0, -4.0, 0.0},
                                   {30.0, 50.0, 0.0}, {Effect::gravity, Effect::basal_friction}, 1.0);
-  s.bed_shape = "flat";
+  s.bed_shape = BedShape::flat;
   s.flat_bed_z = 0.0;
   s.bed_friction = 0.5;
   s = test::finish(s);

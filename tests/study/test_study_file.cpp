@@ -134,7 +134,7 @@ TEST(StudyFile, AnySceneParameterByJsonPointer) {
   const Study s = parse(j);
   ASSERT_EQ(s.cases.size(), 6u);
   std::set<std::pair<double, std::string>> seen;
-  for (const auto& c : s.cases) seen.emplace(c.scene.bed_friction, c.scene.bed_shape);
+  for (const auto& c : s.cases) seen.emplace(c.scene.bed_friction, kind_name(c.scene.bed_shape));
   EXPECT_EQ(seen.size(), 6u);
 }
 
@@ -388,7 +388,7 @@ TEST(ShippedStudies, AllLoadAndQuickSpansWeakToStrongIce) {
   std::size_t resolved = 0;
   for (const auto& c : quick.cases) {
     EXPECT_EQ(c.scene.dim, 2);
-    EXPECT_EQ(c.scene.drive_boundary, "inflow");
+    EXPECT_EQ(c.scene.drive_boundary, DriveBoundary::inflow);
     EXPECT_GT(c.scene.draped_length, c.scene.upstream_length + c.scene.step_length);
     EXPECT_LE(c.scene.ice_thickness, 200.0);
     lo = std::min(lo, c.groups.cohesion_ratio);

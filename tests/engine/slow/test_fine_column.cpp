@@ -18,7 +18,7 @@ double base_stress_error(double dx) {
   SceneConfig s = test::box_scene(2, {0, 0, 0}, {kWidth, kHeight, 0}, {0, -3 * dx, 0},
                                   {kWidth, kHeight + 6 * dx, 0},
                                   {Effect::gravity, Effect::basal_friction, Effect::box_walls}, dx);
-  s.bed_shape = "flat";
+  s.bed_shape = BedShape::flat;
   s.bed_friction = 0.0;
   s.wall_axes = {0};
   s = test::finish(s);
