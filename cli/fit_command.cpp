@@ -1,4 +1,4 @@
-#include "study/fit_command.hpp"
+#include "cli/fit_command.hpp"
 
 #include <cmath>
 #include <cstdio>

@@ -1,9 +1,9 @@
-#include "study/status_command.hpp"
+#include "cli/status_command.hpp"
 
 #include <cstdio>
 #include <string>
 
-#include "study/progress_printer.hpp"
+#include "cli/progress_printer.hpp"
 #include "study/store.hpp"
 
 namespace crevasse {

@@ -1,4 +1,4 @@
-#include "study/study_command.hpp"
+#include "cli/study_command.hpp"
 
 #include <unistd.h>
 
@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <thread>
 
-#include "study/progress_printer.hpp"
+#include "cli/progress_printer.hpp"
 #include "study/runner.hpp"
 #include "study/shard.hpp"
 #include "study/study_file.hpp"

@@ -8,17 +8,17 @@
 #include <optional>
 #include <string>
 
+#include "cli/accuracy_command.hpp"
+#include "cli/calibrate_command.hpp"
+#include "cli/export_command.hpp"
+#include "cli/fit_command.hpp"
+#include "cli/plot_command.hpp"
+#include "cli/run_command.hpp"
+#include "cli/status_command.hpp"
+#include "cli/study_command.hpp"
 #include "engine/error.hpp"
-#include "study/accuracy_command.hpp"
-#include "study/calibrate_command.hpp"
-#include "study/export_command.hpp"
-#include "study/fit_command.hpp"
 #include "study/json_checks.hpp"
 #include "study/merge.hpp"
-#include "study/plot_command.hpp"
-#include "study/run_command.hpp"
-#include "study/status_command.hpp"
-#include "study/study_command.hpp"
 
 namespace {
 

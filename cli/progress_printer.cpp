@@ -1,4 +1,4 @@
-#include "study/progress_printer.hpp"
+#include "cli/progress_printer.hpp"
 
 #include <unistd.h>
 

@@ -1,4 +1,4 @@
-#include "study/accuracy_command.hpp"
+#include "cli/accuracy_command.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,10 +12,10 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/regime_diagram.hpp"
+#include "cli/csv_file.hpp"
 #include "engine/error.hpp"
-#include "study/json_checks.hpp"
 #include "study/case_results.hpp"
-#include "study/csv_file.hpp"
+#include "study/json_checks.hpp"
 #include "study/store.hpp"
 #include "study/study_fit.hpp"
 

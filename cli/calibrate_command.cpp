@@ -1,4 +1,4 @@
-#include "study/calibrate_command.hpp"
+#include "cli/calibrate_command.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,9 +7,9 @@
 #include <vector>
 
 #include "analysis/calibration.hpp"
+#include "cli/csv_file.hpp"
 #include "engine/error.hpp"
 #include "study/case_results.hpp"
-#include "study/csv_file.hpp"
 #include "study/field_observations.hpp"
 #include "study/fits_table.hpp"
 #include "study/store.hpp"

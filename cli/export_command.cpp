@@ -1,4 +1,4 @@
-#include "study/export_command.hpp"
+#include "cli/export_command.hpp"
 
 #include <cstdio>
 #include <fstream>
@@ -6,10 +6,10 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "cli/csv_file.hpp"
 #include "engine/error.hpp"
-#include "study/json_checks.hpp"
-#include "study/csv_file.hpp"
 #include "study/fits_table.hpp"
+#include "study/json_checks.hpp"
 #include "study/store.hpp"
 
 namespace crevasse {

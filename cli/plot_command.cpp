@@ -1,4 +1,4 @@
-#include "study/plot_command.hpp"
+#include "cli/plot_command.hpp"
 
 #include <algorithm>
 #include <cmath>
