@@ -16,6 +16,13 @@ std::string format_duration(double seconds) {
   return buf;
 }
 
+std::string format_wall_time(double seconds) {
+  if (seconds >= 60) return format_duration(seconds);
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1fs", seconds);
+  return buf;
+}
+
 ProgressPrinter::ProgressPrinter(std::FILE* out) : out_(out), tty_(isatty(fileno(out)) != 0) {}
 
 void ProgressPrinter::update(const std::string& line) {

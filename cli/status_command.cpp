@@ -18,13 +18,6 @@ std::string cell(const Statement& s, int c, const char* format) {
   return buf;
 }
 
-std::string wall(double s) {
-  if (s >= 60) return format_duration(s);
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.1fs", s);
-  return buf;
-}
-
 }  // namespace
 
 int status_command(const StatusCommandOptions& opt) {
@@ -109,7 +102,8 @@ int status_command(const StatusCommandOptions& opt) {
                   cell(s, 2, "%.0f").c_str(), cell(s, 3, "%.4g").c_str(),
                   cell(s, 4, "%.3g").c_str(), cell(s, 5, "%.3g").c_str(),
                   static_cast<long long>(s.integer(6)), cell(s, 7, "%.3f").c_str(),
-                  cell(s, 8, "%.3f").c_str(), wall(s.real(9)).c_str(), s.text(10).c_str(),
+                  cell(s, 8, "%.3f").c_str(), format_wall_time(s.real(9)).c_str(),
+                  s.text(10).c_str(),
                   s.integer(11) ? "  (fragmented)" : "",
                   s.integer(12) ? "  (under-resolved: c/(rho_i g) < 3 dx)" : "");
     }
