@@ -26,8 +26,8 @@
 
 #include "bench/bench_main.hpp"
 #include "bench/bench_scene.hpp"
+#include "bench/shipped_scene.hpp"
 #include "engine/simulation.hpp"
-#include "tests/engine/scene_builders.hpp"  // shipped_scene_json: the shipped scene files
 
 namespace {
 
@@ -187,7 +187,7 @@ void sort_step_benchmark(benchmark::State& state, const SceneConfig& scene) {
 
 // The shipped H_i = 300 m glacier (18,000 particles), which also carries the gate records and
 // the piston marker, and whose grid box includes the air above the step.
-SceneConfig glacier_scene() { return scene_from_json(test::shipped_scene_json("glacier_2d_H300.json")); }
+SceneConfig glacier_scene() { return scene_from_json(shipped_scene_json("glacier_2d_H300.json")); }
 
 void register_all() {
   for (int dim : {2, 3}) {

@@ -57,7 +57,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("db")
     ap.add_argument("--reference", type=float, default=4.0, help="reference drive speed [m/s]")
-    ap.add_argument("--crevasse", default="build/study/crevasse")
+    ap.add_argument("--crevasse", default="build/cli/crevasse")
     args = ap.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         subprocess.run([args.crevasse, "export", args.db, "--csv", tmp], check=True,

@@ -7,7 +7,7 @@ the same command after each. Checks that the database passes integrity_check, ev
 exactly once with the result hash of the uninterrupted run, and every SIGINT ended the process
 with exit code 130. Prints the figures.
 
-    python3 scripts/kill_resume.py [--kills 20] [--interrupts 5] [--binary build/study/crevasse]
+    python3 scripts/kill_resume.py [--kills 20] [--interrupts 5] [--binary build/cli/crevasse]
 """
 import argparse
 import json
@@ -27,7 +27,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--kills", type=int, default=20)
     ap.add_argument("--interrupts", type=int, default=5)
-    ap.add_argument("--binary", default=os.path.join(ROOT, "build", "study", "crevasse"))
+    ap.add_argument("--binary", default=os.path.join(ROOT, "build", "cli", "crevasse"))
     ap.add_argument("--seed", type=int, default=1)
     a = ap.parse_args()
     rng = random.Random(a.seed)

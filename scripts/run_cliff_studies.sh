@@ -17,7 +17,7 @@
 # memory are its own); all but spacing_vs_cohesion measured on an engine about half as fast.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-crevasse=./build/study/crevasse
+crevasse=./build/cli/crevasse
 if [[ ! -x $crevasse ]]; then
   bash scripts/install_deps.sh
   cmake -S . -B build -DCMAKE_BUILD_TYPE=Release

@@ -9,7 +9,7 @@ bash scripts/install_deps.sh
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j "$(nproc)"
 mkdir -p runs
-./build/study/crevasse study studies/quick.json --db runs/quick.db --views runs/quick_figures/cases
-./build/study/crevasse status runs/quick.db
-./build/study/crevasse fit runs/quick.db
-./build/study/crevasse plot runs/quick.db --out runs/quick_figures
+./build/cli/crevasse study studies/quick.json --db runs/quick.db --views runs/quick_figures/cases
+./build/cli/crevasse status runs/quick.db
+./build/cli/crevasse fit runs/quick.db
+./build/cli/crevasse plot runs/quick.db --out runs/quick_figures

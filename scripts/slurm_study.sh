@@ -20,7 +20,7 @@ fi
 study=$1
 shards=$2
 shift 2
-crevasse=${CREVASSE:-build/study/crevasse}
+crevasse=${CREVASSE:-build/cli/crevasse}
 cpus=${SLURM_CPUS:-2}
 time_limit=${SLURM_TIME:-1-00:00:00}
 [[ -x $crevasse ]] || { echo "$0: $crevasse not found; build first (scripts/test.sh) or set CREVASSE" >&2; exit 2; }

@@ -100,10 +100,13 @@ std::vector<CaseRecord> read_case_records(Store& store) {
   return out;
 }
 
-std::string study_title(Store& store) {
+std::string study_name(Store& store, const std::string& fallback) {
   Statement s(store.handle(), "SELECT name FROM study WHERE id = 1");
-  const std::string name = s.step() ? s.text(0) : std::string("?");
-  return "study '" + name + "' (" + store.path().string() + ")";
+  return s.step() ? s.text(0) : fallback;
+}
+
+std::string study_title(Store& store) {
+  return "study '" + study_name(store, "?") + "' (" + store.path().string() + ")";
 }
 
 }  // namespace crevasse

@@ -76,6 +76,9 @@ struct CaseRecord {
 // study or no cases.
 std::vector<CaseRecord> read_case_records(Store& store);
 
+// The study's name, or `fallback` when the database holds no study.
+std::string study_name(Store& store, const std::string& fallback);
+
 // "study 'quick' (results/quick.db)".
 std::string study_title(Store& store);
 

@@ -1,7 +1,7 @@
 #pragma once
 // The real case function of the runner: simulate the case's scene with the engine, then
 // measure its crevasses (docs/measurement.md) at the end of the run.
-#include "study/runner.hpp"
+#include "study/case_context.hpp"
 
 namespace crevasse {
 

@@ -111,22 +111,6 @@ int default_jobs(int threads_per_case) {
   return std::max(1, cores / std::max(1, threads_per_case));
 }
 
-CaseContext::CaseContext(int threads, double time_limit_s,
-                         const analysis::MeasureSettings& measurement,
-                         const std::atomic<bool>& stop, std::atomic<double>& fraction)
-    : threads_(threads),
-      time_limit_s_(time_limit_s),
-      measurement_(measurement),
-      stop_(stop),
-      fraction_(fraction),
-      start_(clock_type::now()) {}
-
-double CaseContext::elapsed_s() const { return seconds_since(start_); }
-
-bool CaseContext::time_limit_exceeded() const {
-  return time_limit_s_ > 0 && elapsed_s() > time_limit_s_;
-}
-
 RunnerReport run_study(const Study& study, const RunnerOptions& opt) {
   const auto t0 = clock_type::now();
   RunnerReport report;

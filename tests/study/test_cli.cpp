@@ -1,7 +1,7 @@
 // The crevasse executable: a bad study file is refused with one line and exit code 2 before
 // any database exists; status, export --csv and the sqlite3 CLI read a study database; a study
 // killed with SIGKILL resumes with the same command, loses nothing, reruns nothing finished,
-// and ends with the same contents as an uninterrupted run.
+// and ends with the same contents as an uninterrupted run; --version names the engine version.
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -46,6 +46,19 @@ TEST(Cli, InvalidStudyFilesExitWithCode2AndCreateNoDatabase) {
   }
   EXPECT_EQ(run_cli(dir.path(), "study bad.json --shard 3/2").code, 2);
   EXPECT_EQ(run_cli(dir.path(), "status no_such.db").code, 2);
+}
+
+// --version prints one line naming the engine version the binary was built with (the version that
+// enters every case hash), and exits 0 without asking for a subcommand.
+TEST(Cli, VersionNamesTheEngineVersion) {
+  test::ScratchDir dir("cli_version");
+  const Result r = run_cli(dir.path(), "--version");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("crevasse ", 0), 0u) << r.out;
+  EXPECT_NE(r.out.find(std::string("(engine ") + CREVASSE_ENGINE_VERSION + ", "), std::string::npos)
+      << r.out;
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << "one line: " << r.out;
+  EXPECT_TRUE(r.err.empty()) << r.err;
 }
 
 // Each subcommand's name and --help text, in the order the top-level --help lists them.

@@ -1,9 +1,9 @@
-#include "study/status_command.hpp"
+#include "cli/status_command.hpp"
 
 #include <cstdio>
 #include <string>
 
-#include "study/progress_printer.hpp"
+#include "cli/progress_printer.hpp"
 #include "study/store.hpp"
 
 namespace crevasse {
@@ -15,13 +15,6 @@ std::string cell(const Statement& s, int c, const char* format) {
   if (s.is_null(c)) return "-";
   char buf[64];
   std::snprintf(buf, sizeof buf, format, s.real(c));
-  return buf;
-}
-
-std::string wall(double s) {
-  if (s >= 60) return format_duration(s);
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.1fs", s);
   return buf;
 }
 
@@ -109,7 +102,8 @@ int status_command(const StatusCommandOptions& opt) {
                   cell(s, 2, "%.0f").c_str(), cell(s, 3, "%.4g").c_str(),
                   cell(s, 4, "%.3g").c_str(), cell(s, 5, "%.3g").c_str(),
                   static_cast<long long>(s.integer(6)), cell(s, 7, "%.3f").c_str(),
-                  cell(s, 8, "%.3f").c_str(), wall(s.real(9)).c_str(), s.text(10).c_str(),
+                  cell(s, 8, "%.3f").c_str(), format_wall_time(s.real(9)).c_str(),
+                  s.text(10).c_str(),
                   s.integer(11) ? "  (fragmented)" : "",
                   s.integer(12) ? "  (under-resolved: c/(rho_i g) < 3 dx)" : "");
     }

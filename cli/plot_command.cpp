@@ -1,4 +1,4 @@
-#include "study/plot_command.hpp"
+#include "cli/plot_command.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,6 +6,7 @@
 #include <map>
 
 #include "analysis/regime_diagram.hpp"
+#include "cli/cli_common.hpp"
 #include "engine/error.hpp"
 #include "study/case_results.hpp"
 #include "study/fits_table.hpp"
@@ -17,16 +18,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
-}
-
 std::string group_value_label(const FitGroup& g, const std::optional<double>& v) {
   if (!v) return std::string(g.symbol) + " n/a";
-  if (std::string(g.name) == "thickness") return "H_i = " + num(*v) + " m";
-  return std::string(g.symbol) + " = " + num(*v);
+  if (std::string(g.name) == "thickness") return "H_i = " + format_number(*v) + " m";
+  return std::string(g.symbol) + " = " + format_number(*v);
 }
 
 // The fixed exponents given on the command line, else those the fits table was made with.
@@ -65,13 +60,6 @@ std::string fit_summary(const analysis::RegimeFit& fit, const StudyFit& study_fi
          ")";
 }
 
-std::vector<fs::path> write_figure(const analysis::Figure& figure, const fs::path& stem) {
-  const fs::path png = stem.string() + ".png", svg = stem.string() + ".svg";
-  figure.write_png(png.string());
-  figure.write_svg(svg.string());
-  return {png, svg};
-}
-
 // Up to four cases with spacings, spread evenly over the group's range.
 std::vector<const CaseRecord*> default_cdf_cases(const std::vector<CaseRecord>& cases,
                                                  const FitGroup& group) {
@@ -103,11 +91,7 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
 
   Store store = Store::open_reader(opt.db_path);
   const std::vector<CaseRecord> cases = read_case_records(store);
-  std::string study_name;
-  {
-    Statement s(store.handle(), "SELECT name FROM study WHERE id = 1");
-    study_name = s.step() ? s.text(0) : "study";
-  }
+  const std::string own_name = study_name(store, "study");
   std::vector<const CaseRecord*> cdf_cases;
   for (std::int64_t index : opt.cdf_cases) {
     const auto it = std::find_if(cases.begin(), cases.end(),
@@ -126,16 +110,11 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
   std::vector<std::string> added_names;
   for (const std::string& path : opt.add_cases) {
     Store other = Store::open_reader(path);
-    Statement s(other.handle(), "SELECT name FROM study WHERE id = 1");
-    added_names.push_back(s.step() ? s.text(0) : path);
+    added_names.push_back(study_name(other, path));
     added.push_back(read_case_records(other));
   }
   // Only once every input has been read: a refusal leaves no folder behind.
-  std::error_code ec;
-  fs::create_directories(opt.out_dir, ec);
-  if (ec || !fs::is_directory(opt.out_dir))
-    throw InputError("--out: cannot create directory " + opt.out_dir +
-                     (ec ? " (" + ec.message() + ")" : ""));
+  create_output_directory("--out", opt.out_dir);
   std::vector<std::pair<const CaseRecord*, std::string>> drawn_cases;
   for (const CaseRecord& c : cases) drawn_cases.emplace_back(&c, "");
   for (std::size_t k = 0; k < added.size(); ++k)
@@ -178,11 +157,7 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
         p.y = *y;
         p.hollow = c.under_resolved && !fit_opts.include_under_resolved;
         p.hollow_reason = "under-resolved: c/(ρ_i g) < 3 dx, not fitted";
-        const auto& quartiles = c.quartiles(q);
-        if (quartiles[0] && quartiles[2] && *quartiles[0] > 0.0) {
-          p.y_q25 = *quartiles[0];
-          p.y_q75 = *quartiles[2];
-        }
+        set_quartile_bar(p, c.quartiles(q));
       } else {
         p.failed = true;
         p.missing_reason = c.missing_reason(q);
@@ -206,7 +181,7 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
       for (const auto& [reason, k] : missing) n += k;
       return n;
     }();
-    std::string shown = analysis::escape_markup(study_name);
+    std::string shown = analysis::escape_markup(own_name);
     for (const std::string& name : added_names) shown += " + " + analysis::escape_markup(name);
     options.title = shown + ": median " +
                     (q == Quantity::spacing ? std::string("spacing") : std::string("depth")) +
@@ -218,7 +193,7 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
     const analysis::Figure figure = analysis::regime_diagram(points, drawn, options);
     const std::string stem =
         std::string(q == Quantity::spacing ? "spacing" : "depth") + "_vs_" + group.name;
-    const auto files = write_figure(figure, fs::path(opt.out_dir) / stem);
+    const auto files = write_png_and_svg(figure, fs::path(opt.out_dir) / stem);
     written.insert(written.end(), files.begin(), files.end());
     std::string missing_text;
     for (const auto& [reason, k] : missing)
@@ -260,12 +235,12 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
     samples.push_back(std::move(sample));
   }
   analysis::CdfFigureOptions cdf;
-  cdf.title = analysis::escape_markup(study_name) + ": crevasse spacings of " + std::to_string(samples.size()) + " case(s)";
+  cdf.title = analysis::escape_markup(own_name) + ": crevasse spacings of " + std::to_string(samples.size()) + " case(s)";
   cdf.x_label = opt.cdf_normalise == "median"      ? "L_p / median L_p of the case"
                 : opt.cdf_normalise == "thickness" ? "L_p/H_i"
                                                    : "L_p [m]";
-  const auto files = write_figure(analysis::empirical_cdf_figure(samples, cdf),
-                                  fs::path(opt.out_dir) / "spacing_cdf");
+  const auto files = write_png_and_svg(analysis::empirical_cdf_figure(samples, cdf),
+                                       fs::path(opt.out_dir) / "spacing_cdf");
   written.insert(written.end(), files.begin(), files.end());
   std::printf("%s: spacing CDFs of case(s)", files.front().c_str());
   for (const CaseRecord* c : cdf_cases) std::printf(" %lld", static_cast<long long>(c->case_index));

@@ -1,4 +1,4 @@
-#include "study/accuracy_command.hpp"
+#include "cli/accuracy_command.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,10 +12,11 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/regime_diagram.hpp"
+#include "cli/cli_common.hpp"
+#include "cli/csv_file.hpp"
 #include "engine/error.hpp"
-#include "study/json_checks.hpp"
 #include "study/case_results.hpp"
-#include "study/csv_file.hpp"
+#include "study/json_checks.hpp"
 #include "study/store.hpp"
 #include "study/study_fit.hpp"
 
@@ -165,11 +166,7 @@ std::vector<fs::path> accuracy_report(const AccuracyCommandOptions& opt, std::st
     if (r.drive_m_s != ref->drive_m_s) p.group += ", V_x = " + cell(r.drive_m_s) + " m/s";
     if (l) {
       p.y = *l;
-      const auto& q = c.quartiles(Quantity::spacing);
-      if (q[0] && q[2] && *q[0] > 0.0) {
-        p.y_q25 = *q[0];
-        p.y_q75 = *q[2];
-      }
+      set_quartile_bar(p, c.quartiles(Quantity::spacing));
     } else {
       p.failed = true;
       p.missing_reason = c.fragmented ? "fragmented" : c.missing_reason(Quantity::spacing);
@@ -185,11 +182,10 @@ std::vector<fs::path> accuracy_report(const AccuracyCommandOptions& opt, std::st
   md_file << md.str();
   if (!md_file) throw InputError("--out: cannot write " + md_path.string());
   const analysis::Figure figure = analysis::regime_diagram(points, {}, options);
-  const fs::path stem = fs::path(opt.out_dir) / "accuracy_cost";
-  figure.write_png(stem.string() + ".png");
-  figure.write_svg(stem.string() + ".svg");
+  const std::vector<fs::path> figure_files =
+      write_png_and_svg(figure, fs::path(opt.out_dir) / "accuracy_cost");
   if (table) *table = md.str();
-  return {csv_path, md_path, stem.string() + ".png", stem.string() + ".svg"};
+  return {csv_path, md_path, figure_files[0], figure_files[1]};
 }
 
 int accuracy_command(const AccuracyCommandOptions& opt) {

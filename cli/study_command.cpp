@@ -1,4 +1,4 @@
-#include "study/study_command.hpp"
+#include "cli/study_command.hpp"
 
 #include <unistd.h>
 
@@ -8,7 +8,8 @@
 #include <cstdio>
 #include <thread>
 
-#include "study/progress_printer.hpp"
+#include "cli/cli_common.hpp"
+#include "cli/progress_printer.hpp"
 #include "study/runner.hpp"
 #include "study/shard.hpp"
 #include "study/study_file.hpp"
@@ -40,13 +41,6 @@ struct InterruptHandlers {
   }
 };
 
-std::string case_wall(double s) {
-  if (s >= 60) return format_duration(s);
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.1fs", s);
-  return buf;
-}
-
 class ConsoleObserver : public StudyObserver {
  public:
   ConsoleObserver(std::string name, std::string db) : name_(std::move(name)), db_(std::move(db)) {}
@@ -72,17 +66,18 @@ class ConsoleObserver : public StudyObserver {
       if (!m.crevasses.empty())
         std::snprintf(
             stats, sizeof stats, "%zu crevasse(s), median spacing %s H_i, median depth %s H_i",
-            m.crevasses.size(), m.spacing_over_h ? fmt(m.spacing_over_h->median).c_str() : "-",
-            m.depth_over_h ? fmt(m.depth_over_h->median).c_str() : "-");
+            m.crevasses.size(),
+            m.spacing_over_h ? format_number(m.spacing_over_h->median).c_str() : "-",
+            m.depth_over_h ? format_number(m.depth_over_h->median).c_str() : "-");
       const SceneConfig& sc = c.scene;
       const bool under =
           analysis::strength_under_resolved(sc.tensile_strength, sc.density, sc.gravity, sc.dx);
       std::fprintf(stderr, "[%zu/%zu] done   %s: %s%s%s (%s)\n", finished, p.total,
                    c.label.c_str(), stats, m.flags.fragmented ? ", fragmented" : "",
-                   under ? ", under-resolved" : "", case_wall(r.wall_s).c_str());
+                   under ? ", under-resolved" : "", format_wall_time(r.wall_s).c_str());
     } else if (r.status == "done") {
       std::fprintf(stderr, "[%zu/%zu] done   %s (%s)\n", finished, p.total, c.label.c_str(),
-                   case_wall(r.wall_s).c_str());
+                   format_wall_time(r.wall_s).c_str());
     } else {
       std::fprintf(stderr, "[%zu/%zu] FAILED %s: %s\n", finished, p.total, c.label.c_str(),
                    r.failure_reason.c_str());
@@ -109,11 +104,6 @@ class ConsoleObserver : public StudyObserver {
   }
 
  private:
-  static std::string fmt(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.3g", v);
-    return buf;
-  }
   // Off a terminal one line every 10 s is enough for a log.
   bool printer_is_tty_throttled(const RunnerProgress& p) {
     if (p.elapsed_s - last_line_s_ < (tty_ ? 0.9 : 10.0)) return true;

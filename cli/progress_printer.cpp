@@ -1,4 +1,4 @@
-#include "study/progress_printer.hpp"
+#include "cli/progress_printer.hpp"
 
 #include <unistd.h>
 
@@ -13,6 +13,13 @@ std::string format_duration(double seconds) {
   if (s >= 3600) std::snprintf(buf, sizeof buf, "%ldh%02ldm", s / 3600, (s % 3600) / 60);
   else if (s >= 60) std::snprintf(buf, sizeof buf, "%ldm%02lds", s / 60, s % 60);
   else std::snprintf(buf, sizeof buf, "%lds", s);
+  return buf;
+}
+
+std::string format_wall_time(double seconds) {
+  if (seconds >= 60) return format_duration(seconds);
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1fs", seconds);
   return buf;
 }
 

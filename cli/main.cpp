@@ -8,17 +8,17 @@
 #include <optional>
 #include <string>
 
+#include "cli/accuracy_command.hpp"
+#include "cli/calibrate_command.hpp"
+#include "cli/export_command.hpp"
+#include "cli/fit_command.hpp"
+#include "cli/plot_command.hpp"
+#include "cli/run_command.hpp"
+#include "cli/status_command.hpp"
+#include "cli/study_command.hpp"
 #include "engine/error.hpp"
-#include "study/accuracy_command.hpp"
-#include "study/calibrate_command.hpp"
-#include "study/export_command.hpp"
-#include "study/fit_command.hpp"
 #include "study/json_checks.hpp"
 #include "study/merge.hpp"
-#include "study/plot_command.hpp"
-#include "study/run_command.hpp"
-#include "study/status_command.hpp"
-#include "study/study_command.hpp"
 
 namespace {
 
@@ -53,11 +53,20 @@ const CLI::Validator kNonEmpty(
     [](std::string& s) -> std::string { return s.empty() ? std::string("empty value") : std::string(); },
     "");
 
+// `crevasse --version`: the program, the engine (its version enters every case hash), and the
+// build that made this binary.
+std::string version_text() {
+  return std::string("crevasse ") + CREVASSE_VERSION + " (engine " + CREVASSE_ENGINE_VERSION +
+         ", " + CREVASSE_BUILD_TYPE + " build, " + CREVASSE_COMPILER + ")";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"crevasse: scaling laws of glacier fracture from MPM parameter studies"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", version_text(),
+                       "Print the program, engine and build versions and exit");
 
   crevasse::RunCommandOptions run_opt;
   auto* run = app.add_subcommand("run", "Simulate one scene: VTU snapshots, side-view PNG, crevasse measurement");

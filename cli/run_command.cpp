@@ -1,4 +1,4 @@
-#include "study/run_command.hpp"
+#include "cli/run_command.hpp"
 
 #include <tbb/global_control.h>
 
@@ -10,11 +10,11 @@
 #include "analysis/bed_contact.hpp"
 #include "analysis/crevasse_measure.hpp"
 #include "analysis/measurement_io.hpp"
+#include "cli/progress_printer.hpp"
 #include "engine/error.hpp"
 #include "engine/run.hpp"
 #include "engine/vtu_writer.hpp"
 #include "study/case_views.hpp"
-#include "study/progress_printer.hpp"
 #include "study/scene_file.hpp"
 
 namespace crevasse {

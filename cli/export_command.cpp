@@ -1,4 +1,4 @@
-#include "study/export_command.hpp"
+#include "cli/export_command.hpp"
 
 #include <cstdio>
 #include <fstream>
@@ -6,10 +6,11 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "cli/cli_common.hpp"
+#include "cli/csv_file.hpp"
 #include "engine/error.hpp"
-#include "study/json_checks.hpp"
-#include "study/csv_file.hpp"
 #include "study/fits_table.hpp"
+#include "study/json_checks.hpp"
 #include "study/store.hpp"
 
 namespace crevasse {
@@ -102,10 +103,7 @@ void export_cases(sqlite3* db, const fs::path& path) {
 
 std::vector<fs::path> export_csv(const fs::path& db_path, const fs::path& dir) {
   Store store = Store::open_reader(db_path);
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec)
-    throw InputError("--csv: cannot create directory " + dir.string() + " (" + ec.message() + ")");
+  create_output_directory("--csv", dir);
   std::vector<fs::path> files;
   // One read transaction, so that the files agree with each other while a study is running.
   store.exec("BEGIN");

@@ -1,10 +1,11 @@
-#include "study/fit_command.hpp"
+#include "cli/fit_command.hpp"
 
 #include <cmath>
 #include <cstdio>
 #include <optional>
 #include <set>
 
+#include "cli/cli_common.hpp"
 #include "engine/error.hpp"
 #include "study/case_results.hpp"
 #include "study/fits_table.hpp"
@@ -15,10 +16,7 @@ namespace crevasse {
 namespace {
 
 std::string num(const std::optional<double>& v, const char* format = "%.3g") {
-  if (!v) return "-";
-  char buf[48];
-  std::snprintf(buf, sizeof buf, format, *v);
-  return buf;
+  return v ? format_number(*v, format) : "-";
 }
 
 std::string interval(const std::optional<double>& lo, const std::optional<double>& hi,

@@ -7,6 +7,7 @@
 namespace crevasse {
 
 std::string format_duration(double seconds);  // "1h02m", "3m20s", "12s"
+std::string format_wall_time(double seconds);  // "12.3s" under a minute, else format_duration
 
 class ProgressPrinter {
  public:

@@ -1,4 +1,4 @@
-#include "study/calibrate_command.hpp"
+#include "cli/calibrate_command.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,9 +7,9 @@
 #include <vector>
 
 #include "analysis/calibration.hpp"
+#include "cli/csv_file.hpp"
 #include "engine/error.hpp"
 #include "study/case_results.hpp"
-#include "study/csv_file.hpp"
 #include "study/field_observations.hpp"
 #include "study/fits_table.hpp"
 #include "study/store.hpp"
@@ -154,6 +154,19 @@ void note_thickness(const StudyLaws& laws, double h) {
         short_number(h).c_str(), short_number(laws.thickness_min).c_str(), short_number(laws.thickness_max).c_str());
 }
 
+void check_level(double level) {
+  if (!(level > 0.5 && level < 1.0))
+    throw InputError("--level: " + short_number(level) + " is outside (0.5, 1)");
+}
+
+// The study's ice constants and the confidence level asked for.
+analysis::CalibrationOptions calibration_options(const StudyLaws& laws, double level) {
+  analysis::CalibrationOptions options;
+  options.ice = laws.ice;
+  options.level = level;
+  return options;
+}
+
 double positive(double v, const std::string& option) {
   if (!std::isfinite(v) || v <= 0.0)
     throw InputError(option + ": must be a positive number, got " + short_number(v));
@@ -193,9 +206,7 @@ std::vector<Answer> invert_in_every_regime(const StudyLaws& laws,
 int calibrate_observations(const CalibrateCommandOptions& opt) {
   const std::vector<FieldObservation> sites = load_field_observations(opt.observations_path);
   const StudyLaws laws = load_laws(opt.db_path);
-  analysis::CalibrationOptions options;
-  options.ice = laws.ice;
-  options.level = opt.level;
+  const analysis::CalibrationOptions options = calibration_options(laws, opt.level);
   print_header(laws, opt.level);
   std::printf("observations: %s (%zu sites)\n\n", opt.observations_path.c_str(), sites.size());
   std::printf("%-32s %9s %-20s %8s %7s  %-26s %10s %-22s %-24s %s\n", "site", "L_p[m]", "spread used",
@@ -279,8 +290,7 @@ int calibrate_observations(const CalibrateCommandOptions& opt) {
 }  // namespace
 
 int calibrate_command(const CalibrateCommandOptions& opt) {
-  if (!(opt.level > 0.5 && opt.level < 1.0))
-    throw InputError("--level: " + short_number(opt.level) + " is outside (0.5, 1)");
+  check_level(opt.level);
   if (!opt.observations_path.empty()) {
     if (opt.spacing_m != 0.0 || !opt.spacing_quartiles.empty() || opt.thickness_m)
       throw InputError("--observations: give either --observations or --spacing [--spacing-quartiles] [--thickness], not both");
@@ -315,9 +325,7 @@ int calibrate_command(const CalibrateCommandOptions& opt) {
   }
 
   const StudyLaws laws = load_laws(opt.db_path);
-  analysis::CalibrationOptions options;
-  options.ice = laws.ice;
-  options.level = opt.level;
+  const analysis::CalibrationOptions options = calibration_options(laws, opt.level);
 
   const std::vector<Answer> answers = invert_in_every_regime(laws, obs, options, "--spacing: ");
   if (std::none_of(answers.begin(), answers.end(), [](const Answer& a) { return a.estimate; })) {
@@ -369,8 +377,7 @@ int calibrate_command(const CalibrateCommandOptions& opt) {
 }
 
 int predict_command(const PredictCommandOptions& opt) {
-  if (!(opt.level > 0.5 && opt.level < 1.0))
-    throw InputError("--level: " + short_number(opt.level) + " is outside (0.5, 1)");
+  check_level(opt.level);
   positive(opt.tensile_strength_pa, "--cohesion");
   positive(opt.thickness_m, "--thickness");
   const StudyLaws laws = load_laws(opt.db_path);
@@ -387,9 +394,7 @@ int predict_command(const PredictCommandOptions& opt) {
   const auto& depth = laws.depth.regimes;
   const auto d = std::find_if(depth.begin(), depth.end(), holds);
   if (d != depth.end()) regime.depth = d->law;
-  analysis::CalibrationOptions options;
-  options.ice = laws.ice;
-  options.level = opt.level;
+  const analysis::CalibrationOptions options = calibration_options(laws, opt.level);
   const analysis::CrevassePrediction p =
       analysis::predict_crevasses(regime, opt.tensile_strength_pa, opt.thickness_m, options);
 

@@ -1,0 +1,31 @@
+#pragma once
+// Helpers that several commands share: numbers in tables and progress lines, the output folder,
+// figures written as PNG and SVG, and the quartile bar of a point on a regime diagram.
+#include <array>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "analysis/plot.hpp"
+#include "analysis/regime_diagram.hpp"
+
+namespace crevasse {
+
+// `v` through printf's `format` ("%.3g" by default), for tables and progress lines.
+std::string format_number(double v, const char* format = "%.3g");
+
+// Creates `dir` and its parents for a command's output; InputError naming `option` when it
+// cannot.
+void create_output_directory(const std::string& option, const std::filesystem::path& dir);
+
+// Writes `figure` as <stem>.png and <stem>.svg; returns the two paths, PNG first.
+std::vector<std::filesystem::path> write_png_and_svg(const analysis::Figure& figure,
+                                                     const std::filesystem::path& stem);
+
+// The error bar of a regime-diagram point from a case's quartiles (Q25, median, Q75): set when
+// both ends are known and Q25 is positive (the axes are logarithmic), else left as none.
+void set_quartile_bar(analysis::RegimePoint& p,
+                      const std::array<std::optional<double>, 3>& quartiles);
+
+}  // namespace crevasse

@@ -1,0 +1,71 @@
+#pragma once
+// What passes between the runner and one case: the case's budget and stop signal in, its
+// outcome back. Both the runner (runner.hpp) and the engine's case function (engine_case.hpp)
+// depend on these types, not on each other.
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "analysis/crevasse_measure.hpp"
+#include "study/study_file.hpp"
+
+namespace crevasse {
+
+// What a case hands back to the runner.
+struct CaseOutcome {
+  bool cancelled = false;  // stopped because the runner asked (fail-fast): stays pending
+  std::string stop_reason;
+  std::int64_t steps = 0;
+  std::int64_t particle_steps = 0;
+  double sim_time_s = 0.0;
+  nlohmann::json run_json = nlohmann::json::object();  // timings and other non-deterministic data
+  nlohmann::json result_extra =
+      nlohmann::json::object();  // deterministic data beyond the measurement
+  std::optional<analysis::CrevasseMeasurement> measurement;
+};
+
+// What the runner gives a case: its budget, a way to learn that it should stop, and a way to
+// report how far it has got (for the ETA).
+class CaseContext {
+ public:
+  CaseContext(int threads, double time_limit_s, const analysis::MeasureSettings& measurement,
+              const std::atomic<bool>& stop, std::atomic<double>& fraction);
+  int threads() const { return threads_; }
+  double time_limit_s() const { return time_limit_s_; }  // 0 = none
+  const analysis::MeasureSettings& measurement() const { return measurement_; }
+  bool time_limit_exceeded() const;
+  bool should_stop() const { return stop_.load() || time_limit_exceeded(); }
+  void report_fraction(double f) { fraction_.store(f); }
+  double elapsed_s() const;
+  // Where the case keeps its checkpoint and how often it writes it (wall s); empty: none.
+  void set_checkpoint(std::filesystem::path file, double interval_s) {
+    checkpoint_file_ = std::move(file);
+    checkpoint_interval_s_ = interval_s;
+  }
+  const std::filesystem::path& checkpoint_file() const { return checkpoint_file_; }
+  double checkpoint_interval_s() const { return checkpoint_interval_s_; }
+  // Where the case writes its side views (empty: none).
+  void set_views_dir(std::filesystem::path dir) { views_dir_ = std::move(dir); }
+  const std::filesystem::path& views_dir() const { return views_dir_; }
+
+ private:
+  int threads_;
+  double time_limit_s_;
+  const analysis::MeasureSettings& measurement_;
+  const std::atomic<bool>& stop_;
+  std::atomic<double>& fraction_;
+  std::chrono::steady_clock::time_point start_;
+  std::filesystem::path checkpoint_file_;
+  double checkpoint_interval_s_ = 0.0;
+  std::filesystem::path views_dir_;
+};
+
+// Runs one case; throws (SimulationError, InputError, anything) to fail it.
+using CaseFunction = std::function<CaseOutcome(const StudyCase&, CaseContext&)>;
+
+}  // namespace crevasse
