@@ -63,7 +63,9 @@ TEST(SceneFields, DocsTableMatchesTheFieldTable) {
     EXPECT_EQ(c[1], f.type);
     EXPECT_EQ(c[2], f.unit);
     EXPECT_EQ(c[3].rfind(f.default_value, 0), 0u) << "default cell '" << c[3] << "', table: " << f.default_value;
-    if (!f.range.empty()) EXPECT_NE(c[4].find(f.range), std::string::npos) << "allowed '" << c[4] << "', table: " << f.range;
+    if (!f.range.empty()) {
+      EXPECT_NE(c[4].find(f.range), std::string::npos) << "allowed '" << c[4] << "', table: " << f.range;
+    }
   }
 }
 
