@@ -114,13 +114,20 @@ class Simulation {
   // the end of this step.
   ParticleEffects<Dim> particle_effects_now() const;
 
-  // Stages.
+  // Stages, in step order. Each says what it reads and writes; the grid's boundary conditions
+  // (engine/grid_boundaries.hpp) read the nodes' mass and velocity and write the velocity.
+  // Every step: re-sorts the particles by cell (every kSortInterval steps), fits the grid's
+  // box to them and builds the P2G colouring. Reads x; writes the particle order, grid_ (empty),
+  // slab_order_, slab_start_.
   void prepare_grid();
+  // P2G. Reads x, v, C, τ, mass, V0 (and ε_v^p with the average); writes the nodes' mass,
+  // momentum (and intact_mass, softening_ with the average).
   void particle_to_grid();
   template <bool Average>
   void scatter_to_grid();  // P2G, with the ΔJ-bar average's weights when Average
   template <class Fn>
   void for_each_particle_coloured(Fn&& fn);  // race-free P2G-style traversal by x-slab parity
+  // Momentum to velocity, plus gravity. Reads and writes the nodes' velocity.
   void grid_velocity(const Vec<Dim>& gravity);
   double drive_speed_now() const { return settling_ ? 0.0 : scene_.drive_velocity(time_); }
   // The inflow holds the nodes up to this many cells from the back: a quadratic stencil reaches
@@ -136,7 +143,9 @@ class Simulation {
   // ΔJ-bar volume averaging fused into the G2P sweeps (simulation.cpp explains it): gather v, C
   // and scatter the weighted ΔJ in one coloured sweep; normalise per node; the update sweep
   // interpolates ΔJ̄ back and updates the particle at once.
+  // Reads the grid's velocity, x, C, mass (softening_); writes v, C and grid_aux_'s sums.
   void gather_velocities_and_scatter_volume();
+  // Reads grid_aux_'s sums and the nodes' intact_mass; writes grid_aux_'s averages.
   void normalise_volume_average();
   struct VolumeSums {
     double jbar, wsum, dj;
@@ -151,13 +160,20 @@ class Simulation {
   }
   // G2P's update sweep: the particle update (engine/particle_update.hpp), the per-particle
   // effects, the time step's summary. Average: after the ΔJ-bar sweeps; otherwise the velocity
-  // gather is fused into it.
+  // gather is fused into it. Reads the grid (velocity or grid_aux_), every particle array;
+  // writes x, v, C, F_E, τ, ε_v^p, summary_ and the clock (finish_step).
   template <bool Plastic, bool Average>
   void update_particles();
   template <bool Plastic>
   void finish_step();
+  // Removes the particles past the outflow line. Reads x; compacts every particle array,
+  // writes removed_mass_ and the gate's archive.
   void remove_outflow();
+  // Copies the band of ice that entered last one particle spacing upstream. Reads the clock,
+  // x; appends particles, writes inflow_mass_, inflow_columns_.
   void inflow();
+  // The next dt from the CFL condition, and the instability checks. Reads summary_ (or v, τ,
+  // x); writes dt_, max_speed_, front_x_; throws SimulationError on an instability.
   void update_time_step();
 
   SceneConfig scene_;
