@@ -1,3 +1,4 @@
+#include "engine/groups.hpp"
 #include "analysis/calibration.hpp"
 
 #include <gsl/gsl_randist.h>
@@ -93,7 +94,7 @@ ConfidenceInterval percentile_interval(std::vector<double>& samples, double leve
 }  // namespace
 
 double cohesion_ratio(double tensile_strength_pa, double thickness_m, const IceConstants& ice) {
-  return tensile_strength_pa / (ice.density_kg_m3 * ice.gravity_m_s2 * thickness_m);
+  return crevasse::cohesion_ratio(tensile_strength_pa, ice.density_kg_m3, ice.gravity_m_s2, thickness_m);
 }
 
 RegimeLaw regime_from_fit(std::string name, const PowerLawFit& spacing_fit,
@@ -221,7 +222,8 @@ CohesionEstimate invert_spacing_for_cohesion(const RegimeLaw& regime,
   const auto cohesion = [&](double log_spacing, double log_a, double b, double scatter) {
     if (!have_thickness) return rho_g * std::exp(log_spacing - scatter - log_a);
     const double log_pi = (log_spacing - log_h - scatter - log_a) / b;
-    return rho_g * *observation.thickness_m * std::exp(log_pi);
+    return stress_from_overburden_ratio(std::exp(log_pi), options.ice.density_kg_m3, options.ice.gravity_m_s2,
+                                        *observation.thickness_m);
   };
   const double log_spacing = std::log(observation.spacing_m);
   estimate.tensile_strength_pa = have_thickness ? cohesion(log_spacing, law.log_a, law.b, 0.0)
@@ -250,10 +252,9 @@ CohesionEstimate invert_spacing_for_cohesion(const RegimeLaw& regime,
   }
 
   if (have_thickness) {
-    const double scale = rho_g * *observation.thickness_m;
-    const ValueWithInterval pi{
-        estimate.tensile_strength_pa / scale,
-        {estimate.interval_pa.lower / scale, estimate.interval_pa.upper / scale}};
+    const auto pi_of = [&](double c) { return cohesion_ratio(c, *observation.thickness_m, options.ice); };
+    const ValueWithInterval pi{pi_of(estimate.tensile_strength_pa),
+                               {pi_of(estimate.interval_pa.lower), pi_of(estimate.interval_pa.upper)}};
     estimate.cohesion_ratio_pi = pi;
     estimate.pi_in_regime_range = regime.pi_min <= pi.value && pi.value <= regime.pi_max;
     estimate.pi_interval_in_regime_range =

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/groups.hpp"
 #include "analysis/surface_profile.hpp"
 #include "engine/snapshot.hpp"
 
@@ -161,7 +162,7 @@ bool uses_gate_frame(const ParticleSnapshot& snapshot, const MeasureSettings& se
 inline constexpr double kStrengthLengthMinCells = 3.0;
 inline bool strength_under_resolved(double tensile_strength_pa, double density, double gravity,
                                     double dx_m) {
-  return tensile_strength_pa / (density * gravity) < kStrengthLengthMinCells * dx_m;
+  return strength_length(tensile_strength_pa, density, gravity) < kStrengthLengthMinCells * dx_m;
 }
 
 }  // namespace crevasse::analysis

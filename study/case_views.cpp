@@ -1,3 +1,4 @@
+#include "engine/groups.hpp"
 #include "study/case_views.hpp"
 
 #include <cstdio>
@@ -12,7 +13,7 @@ void write_case_views(const SceneConfig& scene, const ParticleSnapshot& final_sn
   if (final_snapshot.size() == 0) return;
   analysis::SideViewOptions view;
   char extra[128];
-  const double pi_group = scene.tensile_strength / (scene.density * scene.gravity * scene.ice_thickness);
+  const double pi_group = cohesion_ratio(scene.tensile_strength, scene.density, scene.gravity, scene.ice_thickness);
   std::snprintf(extra, sizeof extra, "c = %.3g MPa   Pi = %.3g", scene.tensile_strength / 1e6, pi_group);
   view.title_extra = extra;
   const std::string side = (dir / (stem + "side_view.png")).string();

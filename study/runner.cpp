@@ -111,192 +111,30 @@ int default_jobs(int threads_per_case) {
   return std::max(1, cores / std::max(1, threads_per_case));
 }
 
-RunnerReport run_study(const Study& study, const RunnerOptions& opt) {
-  const auto t0 = clock_type::now();
-  RunnerReport report;
-  report.threads_per_case = opt.threads_per_case > 0 ? opt.threads_per_case
-                            : study.resources.threads_per_case > 0
-                                ? study.resources.threads_per_case
-                                : kDefaultThreadsPerCase;
-  report.jobs = opt.jobs > 0               ? opt.jobs
-                : study.resources.jobs > 0 ? study.resources.jobs
-                                           : default_jobs(report.threads_per_case);
-  const double time_limit = opt.case_time_limit_s.value_or(study.resources.case_time_limit_s);
-  const CaseFunction case_function =
-      opt.case_function ? opt.case_function : CaseFunction(run_engine_case);
+namespace {
 
-  // Everything that can refuse the run does so before a case starts.
-  Store store = Store::open_writer(opt.db_path);
-  store.init_study(study);
-  const std::vector<const StudyCase*> scope =
-      opt.shard ? shard_cases(study, *opt.shard) : shard_cases(study, Shard{0, 1});
-  report.in_scope = scope.size();
-  store.add_cases(scope);
-  report.interrupted = static_cast<std::size_t>(store.reset_running());
-
-  SessionInfo session;
-  session.host = host_name();
-  session.pid = static_cast<std::int64_t>(::getpid());
-  session.started_at = utc_now_iso8601();
-  session.session_id = session.host + ":" + std::to_string(session.pid) + ":" +
-                       std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(
-                                          std::chrono::system_clock::now().time_since_epoch())
-                                          .count());
-  session.jobs = report.jobs;
-  session.threads_per_case = report.threads_per_case;
-  session.shard = opt.shard ? opt.shard->text() : "";
-  session.command = opt.command;
-  store.begin_session(session);
-  report.session_id = session.session_id;
-
-  const auto status = store.statuses();
-  std::vector<const StudyCase*> todo;
-  for (const StudyCase* c : scope) {
-    const std::string& s = status.at(c->case_id);
-    if (s == "done")
-      ++report.already_done;
-    else if (s == "failed" && !opt.retry_failed)
-      ++report.already_failed;
-    else
-      todo.push_back(c);
+// How long the cases still to run will take: the mean wall time of the cases finished so far,
+// or, before any has finished, what the running ones project from their progress.
+class EtaEstimator {
+ public:
+  EtaEstimator(const std::vector<std::atomic<double>>& fraction, int jobs) : fraction_(fraction), jobs_(jobs) {}
+  void started(std::size_t slot) { running_[slot] = clock_type::now(); }
+  void stopped(std::size_t slot) { running_.erase(slot); }
+  void finished(std::size_t slot, double wall_s) {
+    running_.erase(slot);
+    finished_walls_.push_back(wall_s);
   }
+  std::size_t running() const { return running_.size(); }
 
-  RunnerProgress progress;
-  progress.total = scope.size();
-  progress.done = report.already_done;
-  progress.failed = report.already_failed;
-  progress.pending = todo.size();
-  if (opt.observer) opt.observer->on_start(report, progress);
-
-  // Workers: `jobs` loops in one arena, each taking the next case; each case runs in its own
-  // arena so that the engine's parallel loops use exactly threads_per_case threads.
-  const int jobs = std::max(
-      1, std::min<int>(report.jobs, static_cast<int>(std::max<std::size_t>(todo.size(), 1))));
-  tbb::global_control parallelism(
-      tbb::global_control::max_allowed_parallelism,
-      static_cast<std::size_t>(std::max(1, jobs * report.threads_per_case)));
-  std::atomic<bool> own_stop{false};
-  std::atomic<bool>& stop = opt.interrupt ? *opt.interrupt : own_stop;
-  std::atomic<std::size_t> next{0};
-  std::vector<std::atomic<double>> fraction(todo.size());
-  for (auto& f : fraction) f.store(0.0);
-  EventQueue queue;
-  const bool exact_peak_rss = jobs == 1;
-  const std::string session_id = session.session_id;
-  const int threads = report.threads_per_case;
-
-  auto work = [&] {
-    while (!stop.load()) {
-      const std::size_t slot = next.fetch_add(1);
-      if (slot >= todo.size()) return;
-      const StudyCase& c = *todo[slot];
-      Event started{Event::Kind::started, slot, {}, utc_now_iso8601()};
-      const std::string started_at = started.started_at;
-      queue.push(std::move(started));
-      if (exact_peak_rss) reset_peak_rss();
-      CaseContext ctx(threads, time_limit, study.measurement, stop, fraction[slot]);
-      if (!opt.views_dir.empty()) ctx.set_views_dir(opt.views_dir);
-      std::filesystem::path checkpoint;
-      if (study.resources.checkpoint_interval_s > 0) {
-        // Next to the database: DB.checkpoints/CASE.ckpt (kept only while the case is unfinished).
-        const std::filesystem::path dir = opt.db_path.string() + ".checkpoints";
-        std::error_code ec;
-        std::filesystem::create_directories(dir, ec);
-        if (!ec) {
-          checkpoint = dir / (c.case_id + ".ckpt");
-          ctx.set_checkpoint(checkpoint, study.resources.checkpoint_interval_s);
-        }
-      }
-      CaseOutcome outcome;
-      std::string failure;
-      try {
-        tbb::task_arena arena(threads);
-        arena.execute([&] { outcome = case_function(c, ctx); });
-      } catch (const SimulationError& e) {
-        failure = e.what();
-      } catch (const InputError& e) {
-        failure = std::string("invalid input: ") + e.what();
-      } catch (const std::bad_alloc&) {
-        failure = "out of memory";
-      } catch (const std::exception& e) {
-        failure = std::string("error: ") + e.what();
-      } catch (...) {
-        failure = "unknown exception";
-      }
-      if (failure.empty() && outcome.cancelled) {
-        if (!ctx.time_limit_exceeded()) {
-          queue.push(Event{Event::Kind::cancelled, slot, {}, started_at});
-          continue;
-        }
-        failure = "time limit: the case ran longer than the case time limit of " +
-                  std::to_string(time_limit) + " s";
-      }
-      if (!checkpoint.empty()) {  // finished or failed for good: nothing to continue from
-        std::error_code ec;
-        std::filesystem::remove(checkpoint, ec);
-      }
-      CaseResult r;
-      r.case_id = c.case_id;
-      r.session_id = session_id;
-      r.started_at = started_at;
-      r.finished_at = utc_now_iso8601();
-      r.wall_s = ctx.elapsed_s();
-      r.threads = threads;
-      r.peak_rss_bytes = peak_rss_bytes();
-      if (failure.empty()) {
-        r.status = "done";
-        r.stop_reason = outcome.stop_reason;
-        r.steps = outcome.steps;
-        r.particle_steps = outcome.particle_steps;
-        r.sim_time_s = outcome.sim_time_s;
-        r.run_json = outcome.run_json;
-        r.run_json["peak_rss_exact"] = exact_peak_rss;
-        r.result_json = deterministic_result(outcome);
-        r.measurement = std::move(outcome.measurement);
-      } else {
-        r.status = "failed";
-        r.failure_reason = failure;
-        r.result_json = {{"status", "failed"}};
-        if (opt.fail_fast) stop.store(true);
-      }
-      queue.push(Event{Event::Kind::finished, slot, std::move(r), started_at});
-    }
-  };
-
-  // One plain thread per job: a job blocks on its case for minutes, which is no work for TBB's
-  // scheduler, and thread start/join is a hand-over ThreadSanitizer can see (TBB's own queues,
-  // in an uninstrumented libtbb, are not). Each case still runs in its own task arena.
-  std::exception_ptr worker_error;
-  std::mutex worker_error_mutex;
-  std::thread executor([&] {
-    std::vector<std::thread> workers;
-    for (int j = 0; j < jobs; ++j)
-      workers.emplace_back([&] {
-        try {
-          work();
-        } catch (...) {
-          const std::lock_guard<std::mutex> lock(worker_error_mutex);
-          if (!worker_error) worker_error = std::current_exception();
-          stop.store(true);
-        }
-      });
-    for (auto& w : workers) w.join();
-    queue.close();
-  });
-
-  // The writer: this thread alone touches the database.
-  std::exception_ptr writer_error;
-  std::map<std::size_t, clock_type::time_point> running;
-  std::vector<double> finished_walls;
-  auto eta = [&]() -> std::optional<double> {
+  std::optional<double> eta(std::size_t pending) const {
     double per_case = 0.0;
-    if (!finished_walls.empty()) {
-      for (double w : finished_walls) per_case += w;
-      per_case /= static_cast<double>(finished_walls.size());
+    if (!finished_walls_.empty()) {
+      for (double w : finished_walls_) per_case += w;
+      per_case /= static_cast<double>(finished_walls_.size());
     } else {
       int n = 0;
-      for (const auto& [slot, start] : running) {
-        const double f = fraction[slot].load();
+      for (const auto& [slot, start] : running_) {
+        const double f = fraction_[slot].load();
         if (f > 0.02) {
           per_case += seconds_since(start) / f;
           ++n;
@@ -305,79 +143,289 @@ RunnerReport run_study(const Study& study, const RunnerOptions& opt) {
       if (n == 0) return std::nullopt;
       per_case /= n;
     }
-    double remaining = static_cast<double>(progress.pending) * per_case;
-    for (const auto& [slot, start] : running) {
-      const double f = fraction[slot].load();
+    double remaining = static_cast<double>(pending) * per_case;
+    for (const auto& [slot, start] : running_) {
+      const double f = fraction_[slot].load();
       const double total = f > 0.02 ? seconds_since(start) / f : per_case;
       remaining += std::max(0.0, total - seconds_since(start));
     }
-    return remaining / jobs;
-  };
-  bool closed = false;
-  while (!closed) {
-    auto [events, is_closed] = queue.take(std::chrono::milliseconds(1000));
-    closed = is_closed;
-    for (Event& e : events) {
-      if (writer_error) break;
-      try {
-        const StudyCase& c = *todo[e.slot];
-        switch (e.kind) {
-          case Event::Kind::started:
-            store.mark_running(c.case_id, session_id, e.started_at, threads);
-            running[e.slot] = clock_type::now();
-            --progress.pending;
-            break;
-          case Event::Kind::cancelled:
-            store.mark_pending(c.case_id);
-            running.erase(e.slot);
-            ++progress.pending;
-            ++report.cancelled;
-            break;
-          case Event::Kind::finished:
-            store.record_result(e.result);
-            running.erase(e.slot);
-            ++report.ran;
-            if (e.result.status == "done") {
-              ++report.done;
-              ++progress.done;
-              finished_walls.push_back(e.result.wall_s);
-            } else {
-              ++report.failed;
-              ++progress.failed;
-              if (report.first_failure.empty())
-                report.first_failure = c.label + ": " + e.result.failure_reason;
+    return remaining / jobs_;
+  }
+
+ private:
+  const std::vector<std::atomic<double>>& fraction_;
+  int jobs_;
+  std::map<std::size_t, clock_type::time_point> running_;
+  std::vector<double> finished_walls_;
+};
+
+// One run of a study: set up (everything that can refuse the run does so before a case
+// starts), the workers that run one case at a time each, and the writer loop on the calling
+// thread, which alone touches the database.
+class StudyRun {
+ public:
+  StudyRun(const Study& study, const RunnerOptions& opt)
+      : study_(study), opt_(opt), t0_(clock_type::now()), store_(Store::open_writer(opt.db_path)) {}
+
+  RunnerReport run() {
+    set_up();
+    const int jobs = std::max(
+        1, std::min<int>(report_.jobs, static_cast<int>(std::max<std::size_t>(todo_.size(), 1))));
+    // Workers: `jobs` loops, each taking the next case; each case runs in its own arena so that
+    // the engine's parallel loops use exactly threads_per_case threads.
+    tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism,
+                                    static_cast<std::size_t>(std::max(1, jobs * report_.threads_per_case)));
+    exact_peak_rss_ = jobs == 1;
+    fraction_ = std::vector<std::atomic<double>>(todo_.size());
+    for (auto& f : fraction_) f.store(0.0);
+    // One plain thread per job: a job blocks on its case for minutes, which is no work for
+    // TBB's scheduler, and thread start/join is a hand-over ThreadSanitizer can see (TBB's own
+    // queues, in an uninstrumented libtbb, are not). Each case still runs in its own task arena.
+    std::exception_ptr worker_error;
+    std::mutex worker_error_mutex;
+    std::thread executor([&] {
+      std::vector<std::thread> workers;
+      for (int j = 0; j < jobs; ++j)
+        workers.emplace_back([&] {
+          try {
+            while (!stop().load()) {
+              const std::size_t slot = next_.fetch_add(1);
+              if (slot >= todo_.size()) return;
+              run_case(slot);
             }
-            progress.running = running.size();
-            progress.elapsed_s = seconds_since(t0);
-            progress.eta_s = eta();
-            if (opt.observer) opt.observer->on_case_finished(c, e.result, progress);
-            break;
-        }
-      } catch (...) {
-        writer_error = std::current_exception();
-        stop.store(true);
+          } catch (...) {
+            const std::lock_guard<std::mutex> lock(worker_error_mutex);
+            if (!worker_error) worker_error = std::current_exception();
+            stop().store(true);
+          }
+        });
+      for (auto& w : workers) w.join();
+      queue_.close();
+    });
+    const std::exception_ptr writer_error = write_events(jobs);
+    executor.join();
+    if (writer_error) std::rethrow_exception(writer_error);
+    if (worker_error) std::rethrow_exception(worker_error);
+    return finish();
+  }
+
+ private:
+  std::atomic<bool>& stop() { return opt_.interrupt ? *opt_.interrupt : own_stop_; }
+
+  void set_up() {
+    report_.threads_per_case = opt_.threads_per_case > 0 ? opt_.threads_per_case
+                               : study_.resources.threads_per_case > 0
+                                   ? study_.resources.threads_per_case
+                                   : kDefaultThreadsPerCase;
+    report_.jobs = opt_.jobs > 0               ? opt_.jobs
+                   : study_.resources.jobs > 0 ? study_.resources.jobs
+                                               : default_jobs(report_.threads_per_case);
+    time_limit_ = opt_.case_time_limit_s.value_or(study_.resources.case_time_limit_s);
+    case_function_ = opt_.case_function ? opt_.case_function : CaseFunction(run_engine_case);
+
+    store_.init_study(study_);
+    const std::vector<const StudyCase*> scope =
+        opt_.shard ? shard_cases(study_, *opt_.shard) : shard_cases(study_, Shard{0, 1});
+    report_.in_scope = scope.size();
+    store_.add_cases(scope);
+    report_.interrupted = static_cast<std::size_t>(store_.reset_running());
+
+    SessionInfo session;
+    session.host = host_name();
+    session.pid = static_cast<std::int64_t>(::getpid());
+    session.started_at = utc_now_iso8601();
+    session.session_id = session.host + ":" + std::to_string(session.pid) + ":" +
+                         std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(
+                                            std::chrono::system_clock::now().time_since_epoch())
+                                            .count());
+    session.jobs = report_.jobs;
+    session.threads_per_case = report_.threads_per_case;
+    session.shard = opt_.shard ? opt_.shard->text() : "";
+    session.command = opt_.command;
+    store_.begin_session(session);
+    report_.session_id = session.session_id;
+
+    const auto status = store_.statuses();
+    for (const StudyCase* c : scope) {
+      const std::string& st = status.at(c->case_id);
+      if (st == "done")
+        ++report_.already_done;
+      else if (st == "failed" && !opt_.retry_failed)
+        ++report_.already_failed;
+      else
+        todo_.push_back(c);
+    }
+    progress_.total = scope.size();
+    progress_.done = report_.already_done;
+    progress_.failed = report_.already_failed;
+    progress_.pending = todo_.size();
+    if (opt_.observer) opt_.observer->on_start(report_, progress_);
+  }
+
+  // One case, on a worker: runs it and hands its start and its end to the writer.
+  void run_case(std::size_t slot) {
+    const StudyCase& c = *todo_[slot];
+    const int threads = report_.threads_per_case;
+    Event started{Event::Kind::started, slot, {}, utc_now_iso8601()};
+    const std::string started_at = started.started_at;
+    queue_.push(std::move(started));
+    if (exact_peak_rss_) reset_peak_rss();
+    CaseContext ctx(threads, time_limit_, study_.measurement, stop(), fraction_[slot]);
+    if (!opt_.views_dir.empty()) ctx.set_views_dir(opt_.views_dir);
+    std::filesystem::path checkpoint;
+    if (study_.resources.checkpoint_interval_s > 0) {
+      // Next to the database: DB.checkpoints/CASE.ckpt (kept only while the case is unfinished).
+      const std::filesystem::path dir = opt_.db_path.string() + ".checkpoints";
+      std::error_code ec;
+      std::filesystem::create_directories(dir, ec);
+      if (!ec) {
+        checkpoint = dir / (c.case_id + ".ckpt");
+        ctx.set_checkpoint(checkpoint, study_.resources.checkpoint_interval_s);
       }
     }
-    progress.running = running.size();
-    progress.elapsed_s = seconds_since(t0);
-    progress.eta_s = eta();
-    if (opt.observer && !writer_error) opt.observer->on_progress(progress);
+    CaseOutcome outcome;
+    std::string failure;
+    try {
+      tbb::task_arena arena(threads);
+      arena.execute([&] { outcome = case_function_(c, ctx); });
+    } catch (const SimulationError& e) {
+      failure = e.what();
+    } catch (const InputError& e) {
+      failure = std::string("invalid input: ") + e.what();
+    } catch (const std::bad_alloc&) {
+      failure = "out of memory";
+    } catch (const std::exception& e) {
+      failure = std::string("error: ") + e.what();
+    } catch (...) {
+      failure = "unknown exception";
+    }
+    if (failure.empty() && outcome.cancelled) {
+      if (!ctx.time_limit_exceeded()) {
+        queue_.push(Event{Event::Kind::cancelled, slot, {}, started_at});
+        return;
+      }
+      failure = "time limit: the case ran longer than the case time limit of " + std::to_string(time_limit_) + " s";
+    }
+    if (!checkpoint.empty()) {  // finished or failed for good: nothing to continue from
+      std::error_code ec;
+      std::filesystem::remove(checkpoint, ec);
+    }
+    CaseResult r;
+    r.case_id = c.case_id;
+    r.session_id = report_.session_id;
+    r.started_at = started_at;
+    r.finished_at = utc_now_iso8601();
+    r.wall_s = ctx.elapsed_s();
+    r.threads = threads;
+    r.peak_rss_bytes = peak_rss_bytes();
+    if (failure.empty()) {
+      r.status = "done";
+      r.stop_reason = outcome.stop_reason;
+      r.steps = outcome.steps;
+      r.particle_steps = outcome.particle_steps;
+      r.sim_time_s = outcome.sim_time_s;
+      r.run_json = outcome.run_json;
+      r.run_json["peak_rss_exact"] = exact_peak_rss_;
+      r.result_json = deterministic_result(outcome);
+      r.measurement = std::move(outcome.measurement);
+    } else {
+      r.status = "failed";
+      r.failure_reason = failure;
+      r.result_json = {{"status", "failed"}};
+      if (opt_.fail_fast) stop().store(true);
+    }
+    queue_.push(Event{Event::Kind::finished, slot, std::move(r), started_at});
   }
-  executor.join();
-  if (writer_error) std::rethrow_exception(writer_error);
-  if (worker_error) std::rethrow_exception(worker_error);
 
-  report.stopped = opt.fail_fast && report.failed > 0;
-  report.interrupted_by_request = opt.interrupt && opt.interrupt->load() && !report.stopped &&
-                                  !writer_error && !worker_error;
-  report.wall_s = seconds_since(t0);
-  const std::string outcome = report.stopped || report.interrupted_by_request ? "stopped"
-                              : report.failed + report.already_failed > 0 ? "failures"
-                                                                          : "complete";
-  store.end_session(session_id, outcome, static_cast<std::int64_t>(report.ran));
-  store.checkpoint();
-  if (opt.observer) opt.observer->on_end(report);
-  return report;
-}
+  // The writer loop: stores what the workers hand over and reports progress, until the workers
+  // are done. Returns the first error of the store (the run then stops).
+  std::exception_ptr write_events(int jobs) {
+    std::exception_ptr writer_error;
+    EtaEstimator eta(fraction_, jobs);
+    const auto update_progress = [&] {
+      progress_.running = eta.running();
+      progress_.elapsed_s = seconds_since(t0_);
+      progress_.eta_s = eta.eta(progress_.pending);
+    };
+    bool closed = false;
+    while (!closed) {
+      auto [events, is_closed] = queue_.take(std::chrono::milliseconds(1000));
+      closed = is_closed;
+      for (Event& e : events) {
+        if (writer_error) break;
+        try {
+          const StudyCase& c = *todo_[e.slot];
+          switch (e.kind) {
+            case Event::Kind::started:
+              store_.mark_running(c.case_id, report_.session_id, e.started_at, report_.threads_per_case);
+              eta.started(e.slot);
+              --progress_.pending;
+              break;
+            case Event::Kind::cancelled:
+              store_.mark_pending(c.case_id);
+              eta.stopped(e.slot);
+              ++progress_.pending;
+              ++report_.cancelled;
+              break;
+            case Event::Kind::finished:
+              store_.record_result(e.result);
+              ++report_.ran;
+              if (e.result.status == "done") {
+                ++report_.done;
+                ++progress_.done;
+                eta.finished(e.slot, e.result.wall_s);
+              } else {
+                eta.stopped(e.slot);
+                ++report_.failed;
+                ++progress_.failed;
+                if (report_.first_failure.empty()) report_.first_failure = c.label + ": " + e.result.failure_reason;
+              }
+              update_progress();
+              if (opt_.observer) opt_.observer->on_case_finished(c, e.result, progress_);
+              break;
+          }
+        } catch (...) {
+          writer_error = std::current_exception();
+          stop().store(true);
+        }
+      }
+      update_progress();
+      if (opt_.observer && !writer_error) opt_.observer->on_progress(progress_);
+    }
+    return writer_error;
+  }
+
+  RunnerReport finish() {
+    report_.stopped = opt_.fail_fast && report_.failed > 0;
+    report_.interrupted_by_request = opt_.interrupt && opt_.interrupt->load() && !report_.stopped;
+    report_.wall_s = seconds_since(t0_);
+    const std::string outcome = report_.stopped || report_.interrupted_by_request ? "stopped"
+                                : report_.failed + report_.already_failed > 0    ? "failures"
+                                                                                 : "complete";
+    store_.end_session(report_.session_id, outcome, static_cast<std::int64_t>(report_.ran));
+    store_.checkpoint();
+    if (opt_.observer) opt_.observer->on_end(report_);
+    return report_;
+  }
+
+  const Study& study_;
+  const RunnerOptions& opt_;
+  const clock_type::time_point t0_;
+  Store store_;
+  RunnerReport report_;
+  RunnerProgress progress_;
+  double time_limit_ = 0.0;
+  CaseFunction case_function_;
+  std::vector<const StudyCase*> todo_;
+  bool exact_peak_rss_ = false;
+  std::vector<std::atomic<double>> fraction_;
+  std::atomic<bool> own_stop_{false};
+  std::atomic<std::size_t> next_{0};
+  EventQueue queue_;
+};
+
+}  // namespace
+
+RunnerReport run_study(const Study& study, const RunnerOptions& opt) { return StudyRun(study, opt).run(); }
 
 }  // namespace crevasse

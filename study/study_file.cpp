@@ -1,3 +1,4 @@
+#include "engine/groups.hpp"
 #include "study/study_file.hpp"
 
 #include <algorithm>
@@ -199,7 +200,7 @@ CaseGroups groups_of(const SceneConfig& s) {
   CaseGroups g;
   g.thickness_m = s.ice_thickness;
   const double overburden = s.density * s.gravity * s.ice_thickness;
-  g.cohesion_ratio = overburden > 0 ? s.tensile_strength / overburden : 0.0;
+  g.cohesion_ratio = overburden > 0 ? cohesion_ratio(s.tensile_strength, s.density, s.gravity, s.ice_thickness) : 0.0;
   g.step_length_ratio = s.step_length / s.ice_thickness;
   g.step_height_ratio = s.step_height / s.ice_thickness;
   if (s.step_length > 0) g.slope = s.step_height / s.step_length;
@@ -322,16 +323,10 @@ json measure_settings_to_json(const analysis::MeasureSettings& s) {
   };
 }
 
-Study parse_study(const std::string& text, const std::filesystem::path& base_dir,
-                  const std::string& source) {
-  Study st;
-  st.source_text = text;
-  const ordered_json doc = parse_json_input<ordered_json>(text, source);
-  if (!doc.is_object()) fail(source, "a study file must be a JSON object");
-  refuse_unknown_keys(doc, "",
-                 {"name", "description", "base_scene", "fixed", "sweep", "replicas", "measurement",
-                  "resources"});
+namespace {
 
+// The study's name, description and base scene (a path relative to the study file, or inline).
+void parse_name_and_base(const ordered_json& doc, const std::filesystem::path& base_dir, Study& st) {
   if (!doc.contains("name") || !doc.at("name").is_string())
     fail("name", "required: a string naming the study");
   st.name = doc.at("name").get<std::string>();
@@ -362,7 +357,10 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
     fail("base_scene", "must be a scene file path or an inline scene object, got " + base.dump());
   }
   if (!st.base_scene.is_object()) fail("base_scene", "the scene must be a JSON object");
+}
 
+// fixed, sweep and replicas.
+void parse_parameters(const ordered_json& doc, Study& st) {
   std::set<std::string> seen;  // parameters set by fixed or sweep
   if (doc.contains("fixed")) {
     const ordered_json& f = doc.at("fixed");
@@ -409,11 +407,9 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
       fail("replicas",
            "set /numerics/seed per replica; remove /numerics/seed from fixed and sweep");
   }
+}
 
-  st.measurement = measure_settings_from_json(
-      doc.contains("measurement") ? json(doc.at("measurement")) : json());
-  st.measurement_json = measure_settings_to_json(st.measurement);
-
+void parse_resources(const ordered_json& doc, Study& st) {
   if (doc.contains("resources")) {
     const ordered_json& r = doc.at("resources");
     if (!r.is_object()) fail("resources", "must be an object");
@@ -430,8 +426,135 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
       st.resources.case_time_limit_s = number_in(
           r.at("case_time_limit_s"), "resources.case_time_limit_s", {0.0, 1e8, false, false});
   }
+}
 
-  // Enumerate: Cartesian product, last axis fastest, replicas innermost.
+// The named parameters of a case (groups, ratios to H_i) written into its scene as the fields
+// they set (docs/study_format.md).
+void apply_named_parameters(json& scene, std::map<std::string, double>& named, const std::string& where,
+                            const SceneConfig& defaults) {
+  // Derived dimensional parameters (docs/model.md), written into these sections.
+  for (const char* section : {"ice", "bed", "numerics", "run"})
+    if (scene.contains(section) && !scene.at(section).is_object())
+      fail(where,
+           std::string(section) + ": must be a JSON object, got " + scene.at(section).dump());
+  const auto has = [&](const char* n) { return named.count(n) > 0; };
+  double h_i = number_at(scene, "/ice/thickness", defaults.ice_thickness);
+  if (has("thickness")) h_i = named["thickness"];
+  scene["ice"]["thickness"] = h_i;
+  if (has("cells_per_thickness")) scene["numerics"]["dx"] = h_i / named["cells_per_thickness"];
+  // Strengths given relative to the overburden ρ_i g H_i.
+  for (const auto& [name, field] : {std::pair{"cohesion_ratio", "tensile_strength"},
+                                    std::pair{"shear_strength_ratio", "shear_strength"}}) {
+    if (!has(name)) continue;
+    const double rho = number_at(scene, "/ice/density", defaults.density);
+    const double g = number_at(scene, "/gravity/g", defaults.gravity);
+    if (!(g > 0))
+      fail(where, std::string(name) + " needs gravity.g > 0 (it is relative to ρ_i g H_i), got g = " + fmt(g));
+    scene["ice"][field] = stress_from_overburden_ratio(named[name], rho, g, h_i);
+  }
+  if (has("step_length_ratio")) scene["bed"]["step_length"] = named["step_length_ratio"] * h_i;
+  if (has("slope")) {
+    const double l_s = number_at(scene, "/bed/step_length", defaults.step_length);
+    if (!(l_s > 0))
+      fail(
+          where,
+          "slope needs a step of non-zero length; this step is vertical (step_length 0), so give "
+          "step_height_ratio instead");
+    scene["bed"]["step_height"] = named["slope"] * l_s;
+  }
+  if (has("step_height_ratio")) scene["bed"]["step_height"] = named["step_height_ratio"] * h_i;
+  if (has("width_ratio")) {
+    const double dim = number_at(scene, "/dim", defaults.dim);
+    if (dim != 3)
+      fail(where, "width_ratio applies to 3D scenes only; this case has dim " + fmt(dim));
+    scene["ice"]["width"] = named["width_ratio"] * h_i;
+  }
+  if (has("front_past_step_ratio"))
+    scene["run"]["front_past_step"] = named["front_past_step_ratio"] * h_i;
+  if (has("gate_length_ratio")) scene["run"]["gate_length"] = named["gate_length_ratio"] * h_i;
+  if (has("gate_offset_ratio")) scene["run"]["gate_offset"] = named["gate_offset_ratio"] * h_i;
+  if (has("upstream_length_ratio"))
+    scene["ice"]["upstream_length"] = named["upstream_length_ratio"] * h_i;
+  if (has("downstream_length_ratio"))
+    scene["bed"]["downstream_length"] = named["downstream_length_ratio"] * h_i;
+}
+
+// Case `index` of the Cartesian product (last axis fastest, replicas innermost), resolved and
+// hashed.
+StudyCase make_case(const Study& st, std::size_t index, const SceneConfig& defaults) {
+  StudyCase c;
+  c.index = index;
+  c.replica = static_cast<int>(index % static_cast<std::size_t>(st.replicas));
+  std::vector<std::size_t> digit(st.axes.size(), 0);  // the case's value index on each axis
+  std::size_t rest = index / static_cast<std::size_t>(st.replicas);
+  for (std::size_t k = st.axes.size(); k-- > 0;) {
+    digit[k] = rest % st.axes[k].values.size();
+    rest /= st.axes[k].values.size();
+  }
+  json scene = st.base_scene;
+  std::map<std::string, double> named;
+  auto apply = [&](const std::string& field, const std::string& name, const json& v) {
+    if (!is_pointer(name)) {
+      named[name] = v.get<double>();
+      return;
+    }
+    try {
+      scene[json::json_pointer(name)] = v;
+    } catch (const json::exception& e) {  // a non-numeric array index, a path through a value
+      fail(field, "cannot set '" + name + "' in this base scene (" + e.what() + ")");
+    }
+  };
+  for (const auto& [name, v] : st.fixed) apply("fixed." + name, name, v);
+  c.axes = json::object();
+  for (std::size_t k = 0; k < st.axes.size(); ++k) {
+    const json& v = st.axes[k].values[digit[k]];
+    apply("sweep." + st.axes[k].name, st.axes[k].name, v);
+    c.axes[st.axes[k].name] = v;
+    c.label += (c.label.empty() ? "" : " ") + st.axes[k].name + "=" + value_label(v);
+  }
+  if (st.replicas > 1) {
+    scene["numerics"]["seed"] = st.first_seed + static_cast<std::uint64_t>(c.replica);
+    c.axes["replica"] = c.replica;
+    c.label += (c.label.empty() ? "" : " ") + std::string("replica=") + std::to_string(c.replica);
+  }
+  if (c.label.empty()) c.label = "base";
+  const std::string where = "case " + std::to_string(index) + " (" + c.label + ")";
+  apply_named_parameters(scene, named, where, defaults);
+  try {
+    c.scene = scene_from_json(scene);
+    check_scene_json(scene, c.scene);  // the fields the engine would otherwise ignore
+  } catch (const InputError& e) {
+    throw InputError(where + ": " + e.what());
+  }
+  if (st.replicas > 1 && c.scene.jitter <= 0)
+    fail("replicas",
+         "replicas differ only by /numerics/seed, which has no effect while /numerics/jitter is "
+         "0; "
+         "set /numerics/jitter in (0, 0.5]");
+  c.scene_json = scene_to_json(c.scene);
+  c.groups = groups_of(c.scene);
+  c.case_id = case_hash(c.scene, st.measurement_json);
+  return c;
+}
+
+}  // namespace
+
+Study parse_study(const std::string& text, const std::filesystem::path& base_dir,
+                  const std::string& source) {
+  Study st;
+  st.source_text = text;
+  const ordered_json doc = parse_json_input<ordered_json>(text, source);
+  if (!doc.is_object()) fail(source, "a study file must be a JSON object");
+  refuse_unknown_keys(doc, "",
+                 {"name", "description", "base_scene", "fixed", "sweep", "replicas", "measurement",
+                  "resources"});
+  parse_name_and_base(doc, base_dir, st);
+  parse_parameters(doc, st);
+  st.measurement = measure_settings_from_json(
+      doc.contains("measurement") ? json(doc.at("measurement")) : json());
+  st.measurement_json = measure_settings_to_json(st.measurement);
+  parse_resources(doc, st);
+
   std::size_t total = static_cast<std::size_t>(st.replicas);
   for (const auto& a : st.axes) {
     total *= a.values.size();
@@ -441,105 +564,8 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
   }
   const SceneConfig defaults;
   std::map<std::string, std::size_t> by_id;
-  std::vector<std::size_t> digit(st.axes.size(), 0);
   for (std::size_t index = 0; index < total; ++index) {
-    StudyCase c;
-    c.index = index;
-    c.replica = static_cast<int>(index % static_cast<std::size_t>(st.replicas));
-    std::size_t rest = index / static_cast<std::size_t>(st.replicas);
-    for (std::size_t k = st.axes.size(); k-- > 0;) {
-      digit[k] = rest % st.axes[k].values.size();
-      rest /= st.axes[k].values.size();
-    }
-    json scene = st.base_scene;
-    std::map<std::string, double> named;
-    auto apply = [&](const std::string& field, const std::string& name, const json& v) {
-      if (!is_pointer(name)) {
-        named[name] = v.get<double>();
-        return;
-      }
-      try {
-        scene[json::json_pointer(name)] = v;
-      } catch (const json::exception& e) {  // a non-numeric array index, a path through a value
-        fail(field, "cannot set '" + name + "' in this base scene (" + e.what() + ")");
-      }
-    };
-    for (const auto& [name, v] : st.fixed) apply("fixed." + name, name, v);
-    c.axes = json::object();
-    for (std::size_t k = 0; k < st.axes.size(); ++k) {
-      const json& v = st.axes[k].values[digit[k]];
-      apply("sweep." + st.axes[k].name, st.axes[k].name, v);
-      c.axes[st.axes[k].name] = v;
-      c.label += (c.label.empty() ? "" : " ") + st.axes[k].name + "=" + value_label(v);
-    }
-    if (st.replicas > 1) {
-      scene["numerics"]["seed"] = st.first_seed + static_cast<std::uint64_t>(c.replica);
-      c.axes["replica"] = c.replica;
-      c.label += (c.label.empty() ? "" : " ") + std::string("replica=") + std::to_string(c.replica);
-    }
-    if (c.label.empty()) c.label = "base";
-    const std::string where = "case " + std::to_string(index) + " (" + c.label + ")";
-
-    // Derived dimensional parameters (docs/model.md), written into these sections.
-    for (const char* section : {"ice", "bed", "numerics", "run"})
-      if (scene.contains(section) && !scene.at(section).is_object())
-        fail(where,
-             std::string(section) + ": must be a JSON object, got " + scene.at(section).dump());
-    const auto has = [&](const char* n) { return named.count(n) > 0; };
-    double h_i = number_at(scene, "/ice/thickness", defaults.ice_thickness);
-    if (has("thickness")) h_i = named["thickness"];
-    scene["ice"]["thickness"] = h_i;
-    if (has("cells_per_thickness")) scene["numerics"]["dx"] = h_i / named["cells_per_thickness"];
-    // Strengths given relative to the overburden ρ_i g H_i.
-    for (const auto& [name, field] : {std::pair{"cohesion_ratio", "tensile_strength"},
-                                      std::pair{"shear_strength_ratio", "shear_strength"}}) {
-      if (!has(name)) continue;
-      const double rho = number_at(scene, "/ice/density", defaults.density);
-      const double g = number_at(scene, "/gravity/g", defaults.gravity);
-      if (!(g > 0))
-        fail(where, std::string(name) + " needs gravity.g > 0 (it is relative to ρ_i g H_i), got g = " + fmt(g));
-      scene["ice"][field] = named[name] * rho * g * h_i;
-    }
-    if (has("step_length_ratio")) scene["bed"]["step_length"] = named["step_length_ratio"] * h_i;
-    if (has("slope")) {
-      const double l_s = number_at(scene, "/bed/step_length", defaults.step_length);
-      if (!(l_s > 0))
-        fail(
-            where,
-            "slope needs a step of non-zero length; this step is vertical (step_length 0), so give "
-            "step_height_ratio instead");
-      scene["bed"]["step_height"] = named["slope"] * l_s;
-    }
-    if (has("step_height_ratio")) scene["bed"]["step_height"] = named["step_height_ratio"] * h_i;
-    if (has("width_ratio")) {
-      const double dim = number_at(scene, "/dim", defaults.dim);
-      if (dim != 3)
-        fail(where, "width_ratio applies to 3D scenes only; this case has dim " + fmt(dim));
-      scene["ice"]["width"] = named["width_ratio"] * h_i;
-    }
-    if (has("front_past_step_ratio"))
-      scene["run"]["front_past_step"] = named["front_past_step_ratio"] * h_i;
-    if (has("gate_length_ratio")) scene["run"]["gate_length"] = named["gate_length_ratio"] * h_i;
-    if (has("gate_offset_ratio")) scene["run"]["gate_offset"] = named["gate_offset_ratio"] * h_i;
-    if (has("upstream_length_ratio"))
-      scene["ice"]["upstream_length"] = named["upstream_length_ratio"] * h_i;
-    if (has("downstream_length_ratio"))
-      scene["bed"]["downstream_length"] = named["downstream_length_ratio"] * h_i;
-
-    try {
-      c.scene = scene_from_json(scene);
-      check_scene_json(scene, c.scene);  // the fields the engine would otherwise ignore
-    } catch (const InputError& e) {
-      throw InputError(where + ": " + e.what());
-    }
-    if (st.replicas > 1 && c.scene.jitter <= 0)
-      fail("replicas",
-           "replicas differ only by /numerics/seed, which has no effect while /numerics/jitter is "
-           "0; "
-           "set /numerics/jitter in (0, 0.5]");
-    c.scene_json = scene_to_json(c.scene);
-    c.groups = groups_of(c.scene);
-    c.case_id = case_hash(c.scene, st.measurement_json);
+    StudyCase c = make_case(st, index, defaults);
     const auto [it, inserted] = by_id.emplace(c.case_id, index);
     if (!inserted)
       fail("sweep", "cases " + std::to_string(it->second) + " (" + st.cases[it->second].label +
