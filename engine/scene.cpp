@@ -506,6 +506,93 @@ void SceneConfig::resolve() {
                             " particles (limit 1e9); use a coarser dx or a smaller scene");
 }
 
+namespace {
+
+[[noreturn]] void refuse(const std::string& field, const std::string& what) {
+  throw InputError(field + ": " + what + " (see docs/scene_format.md)");
+}
+
+void check_coordinate(const std::string& field, double v, double lo, double hi) {
+  if (!(v >= lo && v <= hi))
+    refuse(field, "value " + fmt(v) + " is outside the allowed range [" + fmt(lo) + ", " + fmt(hi) + "]");
+}
+
+// "[a]": built by appending, because g++ 12 warns falsely (-Wrestrict) on "[" + to_string(a).
+std::string index_suffix(long a) {
+  std::string out = "[";
+  out += std::to_string(a);
+  out += ']';
+  return out;
+}
+
+// A key given with a non-null value (ObjectReader treats null as absent).
+bool given(const nlohmann::json& j, const char* section, const char* key) {
+  if (!j.is_object() || !j.contains(section)) return false;
+  const auto& o = j.at(section);
+  return o.is_object() && o.contains(key) && !o.at(key).is_null();
+}
+
+// Refusals beyond the types and ranges: fields the engine would silently ignore (velocity_boxes
+// without the 'velocity_boundaries' effect and the effect without boxes, domain.min/max for a
+// slab, domain.wall_axes without 'box_walls' and the effect without axes, a non-zero bed.z for
+// a bed that is not flat) and coordinates without a range of their own (domain and velocity-box
+// corners within 1e6 cells of 0, velocity-box velocities within ±1000 m/s, a flat bed.z between
+// the domain's bottom and the ice box's bottom). `j` is the scene's JSON, `s` what was read from
+// it and resolved.
+void check_given_fields(const nlohmann::json& j, const SceneConfig& s) {
+  const int z = s.dim - 1;
+  const std::string axis_z = index_suffix(z);
+  // Fields the engine would ignore without a word.
+  if (!s.velocity_boxes.empty() && !s.has(Effect::velocity_boundaries))
+    refuse("velocity_boxes", std::to_string(s.velocity_boxes.size()) +
+                                 " box(es) given but effects does not list 'velocity_boundaries', so "
+                                 "they would be ignored; add the effect or remove the boxes");
+  if (s.has(Effect::velocity_boundaries) && s.velocity_boxes.empty())
+    refuse("effects", "'velocity_boundaries' needs at least one entry in velocity_boxes");
+  if (s.body == Body::slab) {
+    for (const char* key : {"min", "max"})
+      if (given(j, "domain", key))
+        refuse(std::string("domain.") + key,
+               "allowed with ice.body 'box' only; a slab's domain is derived from ice and bed "
+               "(remove domain.min and domain.max)");
+  }
+  if (!s.wall_axes.empty() && !s.has(Effect::box_walls))
+    refuse("domain.wall_axes", "given but effects does not list 'box_walls', so the walls would be "
+                               "ignored; add the effect or remove wall_axes");
+  if (s.has(Effect::box_walls) && s.wall_axes.empty())
+    refuse("effects", "'box_walls' needs at least one axis in domain.wall_axes");
+  if (s.bed_shape != BedShape::flat && given(j, "bed", "z") && s.flat_bed_z != 0.0)
+    refuse("bed.z", "value " + fmt(s.flat_bed_z) + " given for bed.shape '" + kind_name(s.bed_shape) +
+                        "'; bed.z applies to bed.shape 'flat' only (remove it)");
+
+  // Coordinates without a range check in the engine's loader. Lattice indices are ints: every
+  // coordinate stays within 1e6 cells of 0, the limit resolve() puts on a domain's extent.
+  const double reach = 1e6 * s.dx;
+  if (s.body == Body::box) {
+    for (int a = 0; a < s.dim; ++a) {
+      check_coordinate("domain.min[" + std::to_string(a) + "]", s.domain_min[a], -reach, reach);
+      check_coordinate("domain.max[" + std::to_string(a) + "]", s.domain_max[a], -reach, reach);
+    }
+  }
+  if (s.bed_shape == BedShape::flat) {
+    // The flat bed lies inside the domain and under the ice, not through it.
+    const double top = s.body == Body::box ? s.box_min[z] : s.domain_max[z];
+    check_coordinate("bed.z", s.flat_bed_z, s.domain_min[z], top);
+  }
+  for (std::size_t i = 0; i < s.velocity_boxes.size(); ++i) {
+    const auto& b = s.velocity_boxes[i];
+    const std::string f = "velocity_boxes[" + std::to_string(i) + "].";
+    for (int a = 0; a < s.dim; ++a) {
+      const std::string ax = index_suffix(a);
+      check_coordinate(f + "min" + ax, b.min[a], -reach, reach);
+      check_coordinate(f + "max" + ax, b.max[a], -reach, reach);
+      check_coordinate(f + "velocity" + ax, b.velocity[a], -1e3, 1e3);
+    }
+  }
+}
+
+}  // namespace
+
 SceneConfig scene_from_json(const nlohmann::json& j) {
   SceneConfig s;
   ObjectReader r(j, "");
@@ -577,6 +664,7 @@ SceneConfig scene_from_json(const nlohmann::json& j) {
   }
   r.refuse_unknown();
   s.resolve();
+  check_given_fields(j, s);
   return s;
 }
 

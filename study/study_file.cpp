@@ -522,7 +522,6 @@ StudyCase make_case(const Study& st, std::size_t index, const SceneConfig& defau
   apply_named_parameters(scene, named, where, defaults);
   try {
     c.scene = scene_from_json(scene);
-    check_scene_json(scene, c.scene);  // the fields the engine would otherwise ignore
   } catch (const InputError& e) {
     throw InputError(where + ": " + e.what());
   }
