@@ -55,7 +55,7 @@ inline constexpr double kIsotropicSpread2 = 1e-150;
 // eigenvalue, as Eigen's solver returns them.
 // The closed form in three parts, so that the engine's 2D update can run the arithmetic over a
 // block of particles in vector registers and only the two logarithms one by one
-// (simulation.cpp, update_particles_2d); principal_hencky_2d chains the same parts, so both give
+// (engine/particle_update.hpp, update_particles_2d); principal_hencky_2d chains the same parts, so both give
 // the same bits. Part 1: the entries of b − I, its half-trace m, half-spread h, off-diagonal d,
 // r = sqrt(h² + d²) and |det F| − 1.
 struct Hencky2dParts {

@@ -465,16 +465,6 @@ template <int Dim>
   return v;
 }
 
-// The 2D update of particles [begin, end), a block of kBlock at a time, with the results of
-// update_particle to the bit (bench/state_hash checks it on whole glacier runs). Per block:
-// (1) one by one, the stencil gather of the ΔJ̄ sums; (2) over the block, the volume ratio and
-// its square root with pow_half's test; (3) pow where that test failed; (4) over the block,
-// ΔF·F_E and the closed-form eigen-solve up to the logarithms' arguments; (5) the two logarithms,
-// one by one; (6) over the block, the frame, τ and the two yield tests; then the stores. The
-// compiler keeps two particles per vector register in (2), (4) and (6). A particle whose trial
-// state is outside a yield surface (at cracks: many once a glacier has cracked) goes from the
-// block's trial state through the return mapping (store_trial_state), as in update_particle;
-// each particle then takes the step's per-particle effects (finish_particle).
 template <int Dim>
 ParticleEffects<Dim> Simulation<Dim>::particle_effects_now() const {
   ParticleEffects<Dim> e = effects_;

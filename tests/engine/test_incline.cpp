@@ -124,8 +124,7 @@ TEST(Incline, SticksWhenTanThetaBelowMu3d) { check_sticking<3>(); }
 namespace crevasse {
 namespace {
 
-// The bed's signed-distance table stops 4 cells above the highest bed point (engine
-// build_bed_table), and a particle above it reads the clamped top row. A block dropped from
+// The bed's signed-distance table stops 4 cells above the highest bed point (engine/bed_field.cpp), and a particle above it reads the clamped top row. A block dropped from
 // 36 m above the flat bed (32 cells above the table) must fall freely, with no projection and
 // no friction until it reaches the bed: each particle at z0 − g t²/2, x unchanged. Then it must
 // reach the bed without sinking into it. The free fall is exact in MLS-MPM for a uniform

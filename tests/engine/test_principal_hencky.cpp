@@ -328,7 +328,7 @@ TEST(PrincipalHencky2D, ReflectionUsesAbsoluteDeterminant) {
 }
 
 TEST(PrincipalHencky2D, RebuiltElasticGradientCarriesTheReturnedStrain) {
-  // The return mapping's rebuild F_E' = U diag(e^{ε' − ε}) Uᵀ F_E (engine/simulation.cpp):
+  // The return mapping's rebuild F_E' = U diag(e^{ε' − ε}) Uᵀ F_E (engine/particle_update.hpp, constitutive_update):
   // the principal strains of F_E' must be ε' and its frame U, to the same accuracy.
   std::mt19937_64 rng(8);
   std::uniform_real_distribution<double> angle(-M_PI, M_PI), unit(-1.0, 1.0);
