@@ -27,8 +27,7 @@ inline double volume_root(double s) {
 
 // ΔJ_used/ΔJ_p from the stencil's Σ w ΔJ̄ (jbar) and Σ w (wsum) and the particle's own ΔJ_p (dj),
 // with `intact` = 1 − D the particle's share of the average. Selects, no branch (a lane's unused
-// quotient may be inf or NaN; it is never selected). wsum = 0 and dj = 1 give exactly 1: no
-// averaging.
+// quotient may be inf or NaN; it is never selected).
 inline double volume_scale_of(double jbar, double wsum, double dj, double intact) {
   const double averaged = intact * (jbar / wsum) + (1.0 - intact) * dj;
   const double used = wsum > 0.0 ? averaged : dj;
@@ -69,7 +68,7 @@ template <int Dim, bool Plastic>
 }
 
 // What the 2D block update needs of a particle before its update: inputs(p, jbar, wsum, dj, soft)
-// fills the volume-average sums (jbar = wsum = 0, dj = 1 without averaging) and e^{−ζ ε_v^p};
+// fills the volume-average sums (read only when Average) and e^{−ζ ε_v^p};
 // `damage` says whether the particle's share of the average is 1 − D. finish(p) is called on each
 // particle once it is written.
 //
@@ -80,7 +79,7 @@ template <int Dim, bool Plastic>
 // compiler keeps two particles per vector register in (2), (4) and (6). A particle whose trial
 // state is outside a yield surface (at cracks: many once a glacier has cracked) goes from the
 // block's trial state through the return mapping (constitutive_update), as in update_particle.
-template <bool Plastic, class Inputs, class Finish>
+template <bool Plastic, bool Average, class Inputs, class Finish>
 inline void update_particles_2d(Particles<2>& P, std::size_t begin, std::size_t end, double dt, bool damage,
                                 const ElasticModuli& moduli, const CappedVonMisesParams& plastic_params,
                                 Inputs&& inputs, Finish&& finish) {
@@ -98,15 +97,19 @@ inline void update_particles_2d(Particles<2>& P, std::size_t begin, std::size_t 
     // The volume ratio and its root (pow_half split in two: the square root and its test over
     // the block, pow one by one where the test fails). ΔF·s with s = 1 is exact, so the
     // unscaled particles need no branch below.
-    for (std::size_t i = 0; i < n; ++i) {
-      vs[i] = volume_scale_of(jbar[i], wsum[i], dj[i], damage ? soft[i] : 1.0);
-      const double root = std::sqrt(vs[i]);
-      const bool unscaled = vs[i] == 1.0;
-      scale[i] = unscaled ? 1.0 : root;
-      need_pow[i] = !unscaled & !sqrt_is_pow_half(vs[i], root);
+    if constexpr (Average) {
+      for (std::size_t i = 0; i < n; ++i) {
+        vs[i] = volume_scale_of(jbar[i], wsum[i], dj[i], damage ? soft[i] : 1.0);
+        const double root = std::sqrt(vs[i]);
+        const bool unscaled = vs[i] == 1.0;
+        scale[i] = unscaled ? 1.0 : root;
+        need_pow[i] = !unscaled & !sqrt_is_pow_half(vs[i], root);
+      }
+      for (std::size_t i = 0; i < n; ++i)
+        if (need_pow[i]) scale[i] = std::pow(vs[i], 0.5);
+    } else {
+      for (std::size_t i = 0; i < n; ++i) scale[i] = 1.0;
     }
-    for (std::size_t i = 0; i < n; ++i)
-      if (need_pow[i]) scale[i] = std::pow(vs[i], 0.5);
     for (std::size_t i = 0; i < n; ++i) {
       const double* c = P.C[b + i].data();  // column-major: C00, C10, C01, C11
       const double* fe = P.F_e[b + i].data();

@@ -499,9 +499,6 @@ void Simulation<Dim>::update_particles() {
       soft = kept_softening ? softening_[p] : 1.0;
     } else {
       gather_velocity(p, w, StencilOffsets<Dim>(w, xg, dx), grid_.flat(w.base()), c_scale);
-      jbar = 0.0;
-      wsum = 0.0;
-      dj = 1.0;
       soft = Plastic ? softening_factor(plastic_, P.eps_v_p[p]) : 1.0;
     }
   };
@@ -514,14 +511,14 @@ void Simulation<Dim>::update_particles() {
         };
         if constexpr (Dim == 2) {
           if (!per_particle_update_) {
-            update_particles_2d<Plastic>(P, r.begin(), r.end(), dt_, damage, moduli_, plastic_, inputs, finish);
+            update_particles_2d<Plastic, Average>(P, r.begin(), r.end(), dt_, damage, moduli_, plastic_, inputs, finish);
             return acc;
           }
         }
         for (std::size_t p = r.begin(); p != r.end(); ++p) {
-          double jbar, wsum, dj, soft;
+          double jbar = 0.0, wsum = 0.0, dj = 1.0, soft = 1.0;
           inputs(p, jbar, wsum, dj, soft);
-          const double scale = volume_scale_of(jbar, wsum, dj, damage ? soft : 1.0);
+          const double scale = Average ? volume_scale_of(jbar, wsum, dj, damage ? soft : 1.0) : 1.0;
           update_particle<Dim, Plastic>(P, p, dt_, scale, soft, moduli_, plastic_);
           finish(p);
         }

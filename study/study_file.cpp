@@ -199,8 +199,8 @@ double number_in(const ordered_json& v, const std::string& field, const Range& r
 CaseGroups groups_of(const SceneConfig& s) {
   CaseGroups g;
   g.thickness_m = s.ice_thickness;
-  const double overburden = s.density * s.gravity * s.ice_thickness;
-  g.cohesion_ratio = overburden > 0 ? cohesion_ratio(s.tensile_strength, s.density, s.gravity, s.ice_thickness) : 0.0;
+  const double pi = cohesion_ratio(s.tensile_strength, s.density, s.gravity, s.ice_thickness);
+  g.cohesion_ratio = std::isfinite(pi) ? pi : 0.0;  // no overburden (g = 0): no Π
   g.step_length_ratio = s.step_length / s.ice_thickness;
   g.step_height_ratio = s.step_height / s.ice_thickness;
   if (s.step_length > 0) g.slope = s.step_height / s.step_length;
