@@ -4,7 +4,8 @@
 // the closest-point return onto {p ≥ p_c(ε_v^p), q ≤ q_y} is two independent clamps that
 // commute (docs/model.md):
 //  * cap:   shift tr ε by −Δ (Δ/d on each principal strain), ε_v^p += Δ, p → p_c(ε_v^p + Δ);
-//  * shear: scale dev ε radially so that q = q_y (isochoric: tr ε unchanged).
+//  * shear: scale dev ε radially so that q = q_y (isochoric: tr ε unchanged); with creep, so
+//    that q is the creep step's q when that is lower.
 #include <algorithm>
 #include <cmath>
 
@@ -25,7 +26,29 @@ struct CappedVonMisesParams {
   // Residual strength of damaged ice as rubble: q_y never drops below M·max(p, 0) (a
   // Drucker–Prager-like friction line; M = 6 sin φ/(3 − sin φ) = 1.2 for φ = 30°). 0 = none.
   double residual_friction_m = 0.0;
+  // Creep (docs/model.md, "Creep"): the deviator also relaxes by Glen's law, the equivalent
+  // plastic strain rate being creep_rate·q^n in simulated time. creep_increment = Δt·creep_rate
+  // is set by the engine each step; 0 = no creep (the rate-independent law).
+  double creep_increment = 0.0;
+  double creep_exponent = 3.0;
 };
+
+// q at the end of one backward-Euler creep step from the trial q_t: the root of
+// f(q) = q + 3μ a q^n − q_t with a = Δt·creep_rate (a radial return moves q by 3μ per unit of
+// equivalent plastic strain). f is increasing and convex on q ≥ 0 and both starting values
+// below have f ≥ 0, so Newton falls monotonically onto the root without overshooting it.
+inline double creep_relaxed(double q_t, double three_mu_a, double n) {
+  if (!(q_t > 0.0)) return q_t;
+  const auto pow_n1 = [n](double q) { return n == 3.0 ? q * q : std::pow(q, n - 1.0); };
+  double q = std::min(q_t, std::pow(q_t / three_mu_a, 1.0 / n));
+  for (int it = 0; it < 100; ++it) {
+    const double qn1 = pow_n1(q);
+    const double step = (q + three_mu_a * qn1 * q - q_t) / (1.0 + n * three_mu_a * qn1);
+    q -= step;
+    if (std::abs(step) <= 1e-14 * q_t) break;
+  }
+  return q;
+}
 
 // The softening factor e^{−ζ ε_v^p} of the cap and of the shear strength. e^{−ζ·0} is exactly 1,
 // so intact ice (most of a glacier) skips the exponential.
@@ -123,8 +146,11 @@ inline ReturnResult<Dim> return_map_capped_von_mises(const Vec<Dim>& eps_trial, 
   const double q_trial = von_mises_of_strain_deviator(m, dev.norm());
   const double q_y = r.cap_active ? shear_strength(p, eps_v_p + r.delta_eps_v, -k * tr_new)
                                   : shear_strength_softened(p, softening, -k * tr_new);
-  if (q_trial > q_y) {
-    dev *= q_y / q_trial;
+  const double q_end = p.creep_increment > 0.0
+                           ? std::min(q_y, creep_relaxed(q_trial, 3.0 * m.mu * p.creep_increment, p.creep_exponent))
+                           : q_y;
+  if (q_trial > q_end) {
+    dev *= q_end / q_trial;
     r.eps = (dev.array() + tr_new / Dim).matrix();
     r.shear_active = true;
   }
@@ -144,7 +170,8 @@ inline bool admissible_2d(double e0, double e1, const ElasticModuli& m, const Ca
   const double d0 = e0 - half, d1 = e1 - half;
   const double q_trial = von_mises_of_strain_deviator(m, std::sqrt(d0 * d0 + d1 * d1));
   const double q_y = shear_strength_softened(p, softening, -k * tr);
-  return !cap_violated(-k * tr, p, softening) & !(q_trial > q_y);
+  // Creeping ice relaxes at every step: none of it keeps its trial state.
+  return !cap_violated(-k * tr, p, softening) & !(q_trial > q_y) & !(p.creep_increment > 0.0);
 }
 
 template <int Dim>

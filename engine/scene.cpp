@@ -278,6 +278,9 @@ const std::vector<FieldSpec>& field_table() {
                    "derived"),
       boolean_field("ice.softening", "damage_softens_shear", P, &S::damage_softens_shear),
       number_field("ice.softening", "residual_friction", P, "–", &S::residual_friction, So, 0, 10),
+      number_field("ice.creep", "rate_factor", P, "Pa⁻ⁿ/s", &S::creep_rate_factor, A, 0, 1),
+      number_field("ice.creep", "exponent", P, "–", &S::creep_exponent, A, 1, 6),
+      number_field("ice.creep", "field_speed", P, "m/s", &S::creep_field_speed, A, 0, 1e3, true),
       kind_field("bed", "shape", P, &S::bed_shape),
       number_field("bed", "step_height", P, "m", &S::step_height, Sl, 0, 1e5),
       number_field("bed", "step_length", P, "m", &S::step_length, Sl, 0, 1e6),
@@ -375,6 +378,12 @@ double SceneConfig::drive_position(double t) const {
   const double tr = std::min(t, T);
   const double ramp = 0.5 * drive_speed * (tr - T / std::numbers::pi * std::sin(std::numbers::pi * tr / T));
   return ramp + drive_speed * std::max(0.0, t - T);
+}
+
+double SceneConfig::creep_rate() const {
+  if (!creeps()) return 0.0;
+  const double speed_up = drive_speed > 0.0 && has(Effect::drive) ? drive_speed / creep_field_speed : 1.0;
+  return speed_up * (2.0 / std::sqrt(3.0)) * creep_rate_factor * std::pow(3.0, -0.5 * creep_exponent);
 }
 
 double SceneConfig::implied_fracture_energy() const {
@@ -616,6 +625,11 @@ SceneConfig scene_from_json(const nlohmann::json& j) {
       read_section(so, "ice.softening");
       so.refuse_unknown();
     }
+    if (const auto* creep = o.child("creep")) {
+      ObjectReader co(*creep, "ice.creep");
+      read_section(co, "ice.creep");
+      co.refuse_unknown();
+    }
     o.refuse_unknown();
   }
   for (const char* section : {"bed", "drive", "gravity", "numerics", "run", "output"}) {
@@ -675,8 +689,11 @@ nlohmann::json scene_json_of(const SceneConfig& s, std::initializer_list<Part> p
   json effects = json::array();
   for (Effect e : s.effects) effects.push_back(effect_name(e));
   json j = {{"dim", s.dim}, {"effects", effects}};
-  for (const auto& f : field_table())
+  for (const auto& f : field_table()) {
+    // Ice without creep has no creep section, so scenes that do not creep keep their case hash.
+    if (f.section == "ice.creep" && !s.creeps()) continue;
     if (std::find(parts.begin(), parts.end(), f.part) != parts.end()) section_of(j, f.section)[f.key] = f.get(s);
+  }
   if (s.body == Body::box) {
     j["ice"]["box_min"] = vec(s.box_min);
     j["ice"]["box_max"] = vec(s.box_max);

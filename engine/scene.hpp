@@ -76,6 +76,12 @@ struct ScenePhysics {
   double fracture_energy = 0.0;       // G [J/m²]; 0 = derived from zeta_ref
   bool damage_softens_shear = true;   // q_y·exp(−ζ ε_v^p) (see capped_von_mises.hpp)
   double residual_friction = 1.2;     // M: damaged ice keeps q ≤ M·p (rubble, φ ≈ 30°)
+  // Creep by Glen's law (docs/model.md, "Creep"), off while the rate factor is 0. The drive's
+  // time is the field's sped up by drive.speed / creep_field_speed, so the creep rate is too.
+  double creep_rate_factor = 0.0;     // A [Pa^-n s^-1] of the real ice; 0 = no creep
+  double creep_exponent = 3.0;        // n
+  double creep_field_speed = 3.17e-6; // speed of the real glacier the drive stands for [m/s] (100 m/a)
+  bool creeps() const { return creep_rate_factor > 0.0; }
 
   // Geometry
   Body body = Body::slab;
@@ -173,6 +179,9 @@ struct SceneConfig : ScenePhysics, SceneNumerics, SceneRun, SceneOutput {
   double drive_velocity(double t) const;  // piston speed at time t [m/s]
   double drive_position(double t) const;  // piston face x at time t (0 at t = 0) [m]
   double implied_fracture_energy() const;  // G = c·dx/ζ [J/m²] (band width h = dx)
+  // Equivalent plastic strain rate per q^n in simulated time: (2/√3)·A·(q/√3)^n, Glen's law in
+  // von Mises terms, sped up as the drive is (real time when there is no drive); 0 without creep.
+  double creep_rate() const;
 };
 
 SceneConfig scene_from_json(const nlohmann::json& j);  // resolve()d; throws InputError

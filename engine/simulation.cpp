@@ -49,6 +49,8 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   plastic_.softening_zeta = scene_.has(Effect::softening) ? scene_.softening_zeta : 0.0;
   plastic_.damage_softens_shear = scene_.damage_softens_shear;
   plastic_.residual_friction_m = scene_.residual_friction;
+  plastic_.creep_exponent = scene_.creep_exponent;
+  creep_rate_ = scene_.has(Effect::plasticity) ? scene_.creep_rate() : 0.0;
   grid_.dx = scene_.dx;
   domain_lo_ = to_vec<Dim>(scene_.domain_min);
   domain_hi_ = to_vec<Dim>(scene_.domain_max);
@@ -485,6 +487,7 @@ void Simulation<Dim>::update_particles() {
   const bool damage = Average && averaging_weights_damage();
   const bool kept_softening = !softening_.empty();  // P2G kept e^{−ζ ε_v^p} (averaged, plastic)
   const ParticleEffects<Dim> effects = particle_effects_now();
+  plastic_.creep_increment = dt_ * creep_rate_;
   // What the update needs of particle p first: with the average, its stencil's sums (its velocity
   // was gathered by gather_velocities_and_scatter_volume); without, the gather itself.
   const auto inputs = [&](std::size_t p, double& jbar, double& wsum, double& dj,

@@ -179,6 +179,7 @@ class Simulation {
   SceneConfig scene_;
   ElasticModuli moduli_;
   CappedVonMisesParams plastic_;
+  double creep_rate_ = 0.0;  // SceneConfig::creep_rate(); plastic_.creep_increment = Δt·this each step
   Particles<Dim> particles_;
   Grid<Dim> grid_;
   std::optional<Bed> bed_;

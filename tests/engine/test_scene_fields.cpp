@@ -91,6 +91,9 @@ TEST(SceneFields, EachKeyReachesItsOwnMember) {
       {"ice.softening.zeta_ref", [](const SceneConfig& s) { return s.zeta_ref; }},
       {"ice.softening.dx_ref", [](const SceneConfig& s) { return s.dx_ref; }},
       {"ice.softening.residual_friction", [](const SceneConfig& s) { return s.residual_friction; }},
+      {"ice.creep.rate_factor", [](const SceneConfig& s) { return s.creep_rate_factor; }},
+      {"ice.creep.exponent", [](const SceneConfig& s) { return s.creep_exponent; }},
+      {"ice.creep.field_speed", [](const SceneConfig& s) { return s.creep_field_speed; }},
       {"bed.step_height", [](const SceneConfig& s) { return s.step_height; }},
       {"bed.step_length", [](const SceneConfig& s) { return s.step_length; }},
       {"bed.downstream_length", [](const SceneConfig& s) { return s.downstream_length; }},
@@ -125,6 +128,9 @@ TEST(SceneFields, EachKeyReachesItsOwnMember) {
 
   std::ifstream in(std::string(CREVASSE_SOURCE_DIR) + "/studies/scenes/glacier_2d.json");
   nlohmann::json j = scene_to_json(scene_from_json(nlohmann::json::parse(in)));
+  // A scene without creep writes no creep section (its case hash stays that of the law without it).
+  EXPECT_FALSE(j["ice"].contains("creep"));
+  j["ice"]["creep"] = {{"rate_factor", 2.4e-24}, {"exponent", 3.0}, {"field_speed", 3.17e-6}};
   const auto pointer = [](std::string path) {
     for (char& c : path)
       if (c == '.') c = '/';
