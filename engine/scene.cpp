@@ -405,6 +405,8 @@ void SceneConfig::resolve() {
     fail("run", "give end_time, front_past_step, gate_length or max_steps, or the run never stops");
   if (has(Effect::softening) && !has(Effect::plasticity))
     fail("effects", "'softening' needs 'plasticity'");
+  if (creeps() && !has(Effect::plasticity))
+    fail("ice.creep.rate_factor", "creep needs the 'plasticity' effect (it relaxes the deviator in the return mapping)");
 
   // ζ: explicit, from G, or crack-band scaled from the reference (docs/model.md).
   if (has(Effect::softening)) {
