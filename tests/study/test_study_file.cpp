@@ -71,6 +71,19 @@ TEST(StudyFile, CartesianProductLastAxisFastestReplicasInnermost) {
   for (std::size_t i = 0; i < s.cases.size(); ++i) EXPECT_EQ(s.cases[i].index, i);
 }
 
+// The creep section is optional (a scene without creep writes none), yet a study may set and
+// sweep its fields by pointer, on a base scene without creep too.
+TEST(StudyFile, CreepFieldsAreSceneParameters) {
+  json j = base_study();
+  j["fixed"] = {{"/ice/creep/rate_factor", 2.4e-24}};
+  j["sweep"] = {{"/ice/creep/field_speed", {3.17e-6, 3.17e-5}}};
+  const Study s = parse_study(j.dump(), ".", "test");
+  ASSERT_EQ(s.cases.size(), 2u);
+  EXPECT_TRUE(s.cases[0].scene.creeps());
+  EXPECT_DOUBLE_EQ(s.cases[1].scene.creep_field_speed, 3.17e-5);
+  EXPECT_NE(s.cases[0].case_id, s.cases[1].case_id);
+}
+
 TEST(StudyFile, DerivesTensileStrengthStepAndWidthFromTheGroups) {
   json j = base_study();
   j["fixed"] = {{"/ice/density", 900.0},
