@@ -179,7 +179,8 @@ E kind_from_name(const std::string& field, const std::string& name) {
 
 // When a field's static range is checked: always; for a slab; with the softening effect; or
 // never here, because its bounds depend on other fields (SceneConfig::resolve checks those).
-enum class When { always, slab, softening, in_resolve };
+// creep: checked only when the ice creeps (ice.creep is an optional section, section_written).
+enum class When { always, slab, softening, creep, in_resolve };
 enum class Part { physics, numerics, run, output };
 
 // One scene field, described once: where it lives in the JSON, its part, type, unit and range.
@@ -257,7 +258,7 @@ FieldSpec kind_field(std::string section, std::string key, Part part, E Owner::*
 const std::vector<FieldSpec>& field_table() {
   using S = SceneConfig;
   constexpr auto P = Part::physics, N = Part::numerics, R = Part::run, O = Part::output;
-  constexpr auto A = When::always, Sl = When::slab, So = When::softening, X = When::in_resolve;
+  constexpr auto A = When::always, Sl = When::slab, So = When::softening, Cr = When::creep, X = When::in_resolve;
   static const std::vector<FieldSpec> table = {
       kind_field("ice", "body", P, &S::body),
       number_field("ice", "density", P, "kg/m³", &S::density, A, 1, 1e5),
@@ -279,8 +280,8 @@ const std::vector<FieldSpec>& field_table() {
       boolean_field("ice.softening", "damage_softens_shear", P, &S::damage_softens_shear),
       number_field("ice.softening", "residual_friction", P, "–", &S::residual_friction, So, 0, 10),
       number_field("ice.creep", "rate_factor", P, "Pa⁻ⁿ/s", &S::creep_rate_factor, A, 0, 1),
-      number_field("ice.creep", "exponent", P, "–", &S::creep_exponent, A, 1, 6),
-      number_field("ice.creep", "field_speed", P, "m/s", &S::creep_field_speed, A, 0, 1e3, true),
+      number_field("ice.creep", "exponent", P, "–", &S::creep_exponent, Cr, 1, 6),
+      number_field("ice.creep", "field_speed", P, "m/s", &S::creep_field_speed, Cr, 0, 1e3, true),
       kind_field("bed", "shape", P, &S::bed_shape),
       number_field("bed", "step_height", P, "m", &S::step_height, Sl, 0, 1e5),
       number_field("bed", "step_length", P, "m", &S::step_length, Sl, 0, 1e6),
@@ -316,6 +317,12 @@ const std::vector<FieldSpec>& field_table() {
 void check_fields(const SceneConfig& s, When when) {
   for (const auto& f : field_table())
     if (f.when == when && f.number) check_range(f.path(), f.number(s), f.lo, f.hi, f.lo_open, f.hi_open);
+}
+
+// ice.creep is optional: ice without creep has no creep section, so scenes that do not creep
+// keep the case hash they had before creep existed.
+bool section_written(const std::string& section, const SceneConfig& s) {
+  return section != "ice.creep" || s.creeps();
 }
 
 // The JSON object at a section's path ("ice.softening" → j["ice"]["softening"]).
@@ -405,8 +412,11 @@ void SceneConfig::resolve() {
     fail("run", "give end_time, front_past_step, gate_length or max_steps, or the run never stops");
   if (has(Effect::softening) && !has(Effect::plasticity))
     fail("effects", "'softening' needs 'plasticity'");
-  if (creeps() && !has(Effect::plasticity))
-    fail("ice.creep.rate_factor", "creep needs the 'plasticity' effect (it relaxes the deviator in the return mapping)");
+  if (creeps()) {
+    if (!has(Effect::plasticity))
+      fail("ice.creep.rate_factor", "creep needs the 'plasticity' effect (it relaxes the deviator in the return mapping)");
+    check_fields(*this, When::creep);
+  }
 
   // ζ: explicit, from G, or crack-band scaled from the reference (docs/model.md).
   if (has(Effect::softening)) {
@@ -681,7 +691,8 @@ namespace {
 
 // The canonical JSON of the fields of the given parts, and of the fields outside the table
 // (dim, effects, the box, the domain and the velocity boxes, all physics).
-nlohmann::json scene_json_of(const SceneConfig& s, std::initializer_list<Part> parts) {
+// every_section: also the optional sections of a scene that does not use them.
+nlohmann::json scene_json_of(const SceneConfig& s, std::initializer_list<Part> parts, bool every_section = false) {
   using nlohmann::json;
   auto vec = [&](const std::array<double, 3>& v) {
     json a = json::array();
@@ -692,8 +703,7 @@ nlohmann::json scene_json_of(const SceneConfig& s, std::initializer_list<Part> p
   for (Effect e : s.effects) effects.push_back(effect_name(e));
   json j = {{"dim", s.dim}, {"effects", effects}};
   for (const auto& f : field_table()) {
-    // Ice without creep has no creep section, so scenes that do not creep keep their case hash.
-    if (f.section == "ice.creep" && !s.creeps()) continue;
+    if (!every_section && !section_written(f.section, s)) continue;
     if (std::find(parts.begin(), parts.end(), f.part) != parts.end()) section_of(j, f.section)[f.key] = f.get(s);
   }
   if (s.body == Body::box) {
@@ -718,6 +728,10 @@ nlohmann::json scene_to_json(const SceneConfig& s) {
   nlohmann::json j = scene_json_of(s, {Part::physics, Part::numerics, Part::run, Part::output});
   j["name"] = s.name;
   return j;
+}
+
+nlohmann::json scene_reference_json() {
+  return scene_json_of(SceneConfig{}, {Part::physics, Part::numerics, Part::run, Part::output}, true);
 }
 
 nlohmann::json scene_results_json(const SceneConfig& s) {

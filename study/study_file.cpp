@@ -106,12 +106,7 @@ void check_pointer(const std::string& field, const std::string& ptr) {
   } catch (const json::exception& e) {
     fail(field, "'" + ptr + "' is not a valid JSON pointer (" + e.what() + ")");
   }
-  // A default scene with its optional creep section written (a scene without creep has none).
-  static const json reference = [] {
-    SceneConfig s;
-    s.creep_rate_factor = 2.4e-24;
-    return scene_to_json(s);
-  }();
+  static const json reference = scene_reference_json();
   // Array indices: setting element 10^11 would allocate every element before it.
   std::istringstream all(ptr.substr(1));
   for (std::string t; std::getline(all, t, '/');)
