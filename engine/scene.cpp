@@ -179,7 +179,7 @@ E kind_from_name(const std::string& field, const std::string& name) {
 
 // When a field's static range is checked: always; for a slab; with the softening effect; or
 // never here, because its bounds depend on other fields (SceneConfig::resolve checks those).
-// creep: checked only when the ice creeps (ice.creep is an optional section, section_written).
+// creep: checked only when the ice creeps (ice.creep is an optional section, field_written).
 enum class When { always, slab, softening, creep, in_resolve };
 enum class Part { physics, numerics, run, output };
 
@@ -301,6 +301,7 @@ const std::vector<FieldSpec>& field_table() {
       integer_field("numerics", "seed", N, &S::seed, X, 0, 0),
       number_field("numerics", "top_margin", N, "m", &S::top_margin, A, 0, 1e6, false, false, "0.5 H_i + 4 dx"),
       boolean_field("numerics", "volumetric_averaging", N, &S::volumetric_averaging),
+      boolean_field("numerics", "average_total_volume", N, &S::average_total_volume),
       number_field("run", "end_time", R, "s", &S::end_time, A, 0, 1e9),
       number_field("run", "front_past_step", R, "m", &S::front_past_step, A, 0, 1e9),
       number_field("run", "gate_length", R, "m", &S::gate_length, X, 0, 1e9),
@@ -319,10 +320,12 @@ void check_fields(const SceneConfig& s, When when) {
     if (f.when == when && f.number) check_range(f.path(), f.number(s), f.lo, f.hi, f.lo_open, f.hi_open);
 }
 
-// ice.creep is optional: ice without creep has no creep section, so scenes that do not creep
-// keep the case hash they had before creep existed.
-bool section_written(const std::string& section, const SceneConfig& s) {
-  return section != "ice.creep" || s.creeps();
+// ice.creep and numerics.average_total_volume are optional: a scene that does not use them does
+// not write them, so it keeps the case hash it had before they existed.
+bool field_written(const FieldSpec& f, const SceneConfig& s) {
+  if (f.section == "ice.creep") return s.creeps();
+  if (f.path() == "numerics.average_total_volume") return s.average_total_volume;
+  return true;
 }
 
 // The JSON object at a section's path ("ice.softening" → j["ice"]["softening"]).
@@ -412,6 +415,8 @@ void SceneConfig::resolve() {
     fail("run", "give end_time, front_past_step, gate_length or max_steps, or the run never stops");
   if (has(Effect::softening) && !has(Effect::plasticity))
     fail("effects", "'softening' needs 'plasticity'");
+  if (average_total_volume && !volumetric_averaging)
+    fail("numerics.average_total_volume", "needs numerics.volumetric_averaging true (it says what the average takes)");
   if (creeps()) {
     if (!has(Effect::plasticity))
       fail("ice.creep.rate_factor", "creep needs the 'plasticity' effect (it relaxes the deviator in the return mapping)");
@@ -703,7 +708,7 @@ nlohmann::json scene_json_of(const SceneConfig& s, std::initializer_list<Part> p
   for (Effect e : s.effects) effects.push_back(effect_name(e));
   json j = {{"dim", s.dim}, {"effects", effects}};
   for (const auto& f : field_table()) {
-    if (!every_section && !section_written(f.section, s)) continue;
+    if (!every_section && !field_written(f, s)) continue;
     if (std::find(parts.begin(), parts.end(), f.part) != parts.end()) section_of(j, f.section)[f.key] = f.get(s);
   }
   if (s.body == Body::box) {

@@ -132,6 +132,9 @@ struct SceneNumerics {
   // update, which removes the particle-scale pressure checkerboard that quadratic MLS-MPM
   // builds near concentrated loads (the lip of the step) and that cracks the ice spuriously.
   bool volumetric_averaging = true;
+  // What the average takes: each step's increment ΔJ (false), or each particle's whole trial
+  // elastic volume ratio ΔJ·det F_E (true), which also removes a checkerboard already built up.
+  bool average_total_volume = false;
   // Settling: the discrete MPM equilibrium differs slightly from the analytic geostatic state,
   // so an undamped start rings and puts the top particle layer into tension. Before t = 0 the
   // slab settles elastically (no return mapping, so no plastic strain), with the drive at rest

@@ -427,7 +427,7 @@ void Simulation<Dim>::gather_velocities_and_scatter_volume() {
     const StencilWeights<Dim> w(xg);
     const std::size_t f0 = grid_.flat(w.base());
     gather_velocity(p, w, StencilOffsets<Dim>(w, xg, dx), f0, c_scale);
-    const double dj = (Mat<Dim>::Identity() + dt_ * P.C[p]).determinant();
+    const double dj = averaged_volume_ratio(p);
     const double wm = averaging_weight(p, damage);  // the weight P2G added to intact_mass
     for_each_stencil_node<Dim>(w, f0, stride,
                                [&](const IVec<Dim>&, std::size_t f, double wt) { aux[2 * f] += wt * wm * dj; });
@@ -463,7 +463,7 @@ template <int Dim>
   });
   v.jbar = sums[0];
   v.wsum = sums[1];
-  v.dj = (Mat<Dim>::Identity() + dt_ * particles_.C[p]).determinant();
+  v.dj = averaged_volume_ratio(p);
   return v;
 }
 

@@ -158,6 +158,13 @@ class Simulation {
   double averaging_weight(std::size_t p, bool damage) const {
     return particles_.mass[p] * (damage ? softening_[p] : 1.0);
   }
+  // What particle p puts into the average: its step's volume ratio ΔJ = det(I + Δt C), or with
+  // numerics.average_total_volume its whole trial elastic volume ratio ΔJ·det F_E. The update
+  // scales ΔF by (averaged / this)^{1/d} either way.
+  double averaged_volume_ratio(std::size_t p) const {
+    const double dj = (Mat<Dim>::Identity() + dt_ * particles_.C[p]).determinant();
+    return scene_.average_total_volume ? dj * particles_.F_e[p].determinant() : dj;
+  }
   // G2P's update sweep: the particle update (engine/particle_update.hpp), the per-particle
   // effects, the time step's summary. Average: after the ΔJ-bar sweeps; otherwise the velocity
   // gather is fused into it. Reads the grid (velocity or grid_aux_), every particle array;
