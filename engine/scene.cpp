@@ -179,7 +179,7 @@ E kind_from_name(const std::string& field, const std::string& name) {
 
 // When a field's static range is checked: always; for a slab; with the softening effect; or
 // never here, because its bounds depend on other fields (SceneConfig::resolve checks those).
-// creep: checked only when the ice creeps (ice.creep is an optional section, field_written).
+// creep: checked only when the ice creeps (ice.creep is an optional section, FieldSpec::written).
 enum class When { always, slab, softening, creep, in_resolve };
 enum class Part { physics, numerics, run, output };
 
@@ -199,15 +199,23 @@ struct FieldSpec {
   std::function<nlohmann::json(const SceneConfig&)> get;
   std::function<void(ObjectReader&, SceneConfig&)> read;
   std::function<double(const SceneConfig&)> number;  // the value the range check reads
+  // Empty: always written. Otherwise an optional field, written into a scene only when this
+  // holds, so that scenes which do not use it keep the case hash they had before it existed.
+  std::function<bool(const SceneConfig&)> written;
   std::string path() const { return section + "." + key; }
 };
+
+FieldSpec written_when(FieldSpec f, std::function<bool(const SceneConfig&)> when) {
+  f.written = std::move(when);
+  return f;
+}
 
 template <class Owner>
 FieldSpec number_field(std::string section, std::string key, Part part, std::string unit, double Owner::*m,
                        When when, double lo, double hi, bool lo_open = false, bool hi_open = false,
                        std::string derived = "") {
   FieldSpec f{std::move(section), key, part, "number", std::move(unit), when, lo, hi, lo_open, hi_open,
-              std::move(derived), {}, {}, {}};
+              std::move(derived), {}, {}, {}, {}};
   f.get = [m](const SceneConfig& s) { return nlohmann::json(s.*m); };
   f.read = [m, key](ObjectReader& r, SceneConfig& s) { r.number(key, s.*m); };
   f.number = [m](const SceneConfig& s) { return s.*m; };
@@ -217,7 +225,7 @@ FieldSpec number_field(std::string section, std::string key, Part part, std::str
 template <class T, class Owner>
 FieldSpec integer_field(std::string section, std::string key, Part part, T Owner::*m, When when, double lo,
                         double hi) {
-  FieldSpec f{std::move(section), key, part, "integer", "–", when, lo, hi, false, false, "", {}, {}, {}};
+  FieldSpec f{std::move(section), key, part, "integer", "–", when, lo, hi, false, false, "", {}, {}, {}, {}};
   f.get = [m](const SceneConfig& s) { return nlohmann::json(s.*m); };
   f.read = [m, key, path = f.path()](ObjectReader& r, SceneConfig& s) {
     std::int64_t v = static_cast<std::int64_t>(s.*m);
@@ -237,7 +245,7 @@ FieldSpec integer_field(std::string section, std::string key, Part part, T Owner
 
 template <class Owner>
 FieldSpec boolean_field(std::string section, std::string key, Part part, bool Owner::*m) {
-  FieldSpec f{std::move(section), key, part, "boolean", "", When::in_resolve, 0, 0, false, false, "", {}, {}, {}};
+  FieldSpec f{std::move(section), key, part, "boolean", "", When::in_resolve, 0, 0, false, false, "", {}, {}, {}, {}};
   f.get = [m](const SceneConfig& s) { return nlohmann::json(s.*m); };
   f.read = [m, key](ObjectReader& r, SceneConfig& s) { r.boolean(key, s.*m); };
   return f;
@@ -245,7 +253,7 @@ FieldSpec boolean_field(std::string section, std::string key, Part part, bool Ow
 
 template <class E, class Owner>
 FieldSpec kind_field(std::string section, std::string key, Part part, E Owner::*m) {
-  FieldSpec f{std::move(section), key, part, "string", "", When::in_resolve, 0, 0, false, false, "", {}, {}, {}};
+  FieldSpec f{std::move(section), key, part, "string", "", When::in_resolve, 0, 0, false, false, "", {}, {}, {}, {}};
   f.get = [m](const SceneConfig& s) { return nlohmann::json(name_of(s.*m)); };
   f.read = [m, key, path = f.path()](ObjectReader& r, SceneConfig& s) {
     std::string name = name_of(s.*m);
@@ -259,6 +267,7 @@ const std::vector<FieldSpec>& field_table() {
   using S = SceneConfig;
   constexpr auto P = Part::physics, N = Part::numerics, R = Part::run, O = Part::output;
   constexpr auto A = When::always, Sl = When::slab, So = When::softening, Cr = When::creep, X = When::in_resolve;
+  const auto creeping = [](const S& s) { return s.creeps(); };
   static const std::vector<FieldSpec> table = {
       kind_field("ice", "body", P, &S::body),
       number_field("ice", "density", P, "kg/m³", &S::density, A, 1, 1e5),
@@ -279,9 +288,10 @@ const std::vector<FieldSpec>& field_table() {
                    "derived"),
       boolean_field("ice.softening", "damage_softens_shear", P, &S::damage_softens_shear),
       number_field("ice.softening", "residual_friction", P, "–", &S::residual_friction, So, 0, 10),
-      number_field("ice.creep", "rate_factor", P, "Pa⁻ⁿ/s", &S::creep_rate_factor, A, 0, 1),
-      number_field("ice.creep", "exponent", P, "–", &S::creep_exponent, Cr, 1, 6),
-      number_field("ice.creep", "field_speed", P, "m/s", &S::creep_field_speed, Cr, 0, 1e3, true),
+      written_when(number_field("ice.creep", "rate_factor", P, "Pa⁻ⁿ/s", &S::creep_rate_factor, A, 0, 1), creeping),
+      written_when(number_field("ice.creep", "exponent", P, "–", &S::creep_exponent, Cr, 1, 6), creeping),
+      written_when(number_field("ice.creep", "field_speed", P, "m/s", &S::creep_field_speed, Cr, 0, 1e3, true),
+                   creeping),
       kind_field("bed", "shape", P, &S::bed_shape),
       number_field("bed", "step_height", P, "m", &S::step_height, Sl, 0, 1e5),
       number_field("bed", "step_length", P, "m", &S::step_length, Sl, 0, 1e6),
@@ -301,7 +311,8 @@ const std::vector<FieldSpec>& field_table() {
       integer_field("numerics", "seed", N, &S::seed, X, 0, 0),
       number_field("numerics", "top_margin", N, "m", &S::top_margin, A, 0, 1e6, false, false, "0.5 H_i + 4 dx"),
       boolean_field("numerics", "volumetric_averaging", N, &S::volumetric_averaging),
-      boolean_field("numerics", "average_total_volume", N, &S::average_total_volume),
+      written_when(boolean_field("numerics", "average_total_volume", N, &S::average_total_volume),
+                   [](const S& s) { return s.average_total_volume; }),
       number_field("run", "end_time", R, "s", &S::end_time, A, 0, 1e9),
       number_field("run", "front_past_step", R, "m", &S::front_past_step, A, 0, 1e9),
       number_field("run", "gate_length", R, "m", &S::gate_length, X, 0, 1e9),
@@ -318,14 +329,6 @@ const std::vector<FieldSpec>& field_table() {
 void check_fields(const SceneConfig& s, When when) {
   for (const auto& f : field_table())
     if (f.when == when && f.number) check_range(f.path(), f.number(s), f.lo, f.hi, f.lo_open, f.hi_open);
-}
-
-// ice.creep and numerics.average_total_volume are optional: a scene that does not use them does
-// not write them, so it keeps the case hash it had before they existed.
-bool field_written(const FieldSpec& f, const SceneConfig& s) {
-  if (f.section == "ice.creep") return s.creeps();
-  if (f.path() == "numerics.average_total_volume") return s.average_total_volume;
-  return true;
 }
 
 // The JSON object at a section's path ("ice.softening" → j["ice"]["softening"]).
@@ -696,7 +699,7 @@ namespace {
 
 // The canonical JSON of the fields of the given parts, and of the fields outside the table
 // (dim, effects, the box, the domain and the velocity boxes, all physics).
-// every_section: also the optional sections of a scene that does not use them.
+// every_section: also the optional fields of a scene that does not use them.
 nlohmann::json scene_json_of(const SceneConfig& s, std::initializer_list<Part> parts, bool every_section = false) {
   using nlohmann::json;
   auto vec = [&](const std::array<double, 3>& v) {
@@ -708,7 +711,7 @@ nlohmann::json scene_json_of(const SceneConfig& s, std::initializer_list<Part> p
   for (Effect e : s.effects) effects.push_back(effect_name(e));
   json j = {{"dim", s.dim}, {"effects", effects}};
   for (const auto& f : field_table()) {
-    if (!every_section && !field_written(f, s)) continue;
+    if (!every_section && f.written && !f.written(s)) continue;
     if (std::find(parts.begin(), parts.end(), f.part) != parts.end()) section_of(j, f.section)[f.key] = f.get(s);
   }
   if (s.body == Body::box) {

@@ -192,8 +192,8 @@ nlohmann::json scene_to_json(const SceneConfig& s);    // canonical, every field
 // The parts that decide what a run computes (all but the name and SceneOutput): what a case's
 // identity, and so its hash, is taken over.
 nlohmann::json scene_results_json(const SceneConfig& s);
-// The canonical form of a default scene with every optional section written (ice.creep): the
-// fields a study's JSON pointer may name.
+// The canonical form of a default scene with every optional field written (ice.creep,
+// numerics.average_total_volume): the fields a study's JSON pointer may name.
 nlohmann::json scene_reference_json();
 
 // One row of the field table, as docs/scene_format.md shows it (the test that holds the docs to
