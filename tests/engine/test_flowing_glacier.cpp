@@ -67,6 +67,24 @@ TEST(FlowingGlacier, DrapedGlacierWithoutDriveShowsNoDamageAfterSettling) {
   EXPECT_LE(sim.max_yield_violation(), 1e-9);
 }
 
+// The same on the quick study's start: the inflow scene with the whole-volume average
+// (studies/quick.json), at rest (inflow speed 0, gravity not tilted, so nothing drives it).
+TEST(FlowingGlacier, InflowGlacierWithTheWholeVolumeAverageShowsNoDamageAtRest) {
+  nlohmann::json j = test::shipped_scene_json("flowing_inflow_2d.json");
+  j["drive"]["speed"] = 0.0;
+  j["numerics"]["volumetric_averaging"] = true;
+  j["numerics"]["average_total_volume"] = true;
+  const SceneConfig scene = scene_from_json(j);
+  Simulation<2> sim(scene);
+  sim.settle();
+  while (sim.time() < 20.0) sim.step();
+  const auto& P = sim.particles();
+  int opened = 0;
+  for (std::size_t p = 0; p < P.size(); ++p) opened += P.eps_v_p[p] > 0.0;
+  EXPECT_EQ(opened, 0);
+  EXPECT_LE(sim.max_yield_violation(), 1e-9);
+}
+
 // "hydrostatic" loads the cryostatic state σ = −ρ g (s − z) I: no deviatoric stress at rest, so a
 // shear strength below the K0 state's q = (1 − 2ν)/(1 − ν)·ρ g (s − z) does not yield at t = 0.
 TEST(FlowingGlacier, HydrostaticStartHasNoDeviatoricStress) {
