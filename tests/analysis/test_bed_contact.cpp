@@ -68,6 +68,18 @@ TEST(BedContact, SnapshotWithoutBedIsRefused) {
   EXPECT_THROW(ramp_contact(s), std::invalid_argument);
 }
 
+// The largest ice–ramp gap of a settled scene over its first `seconds`, sampled every 250 steps.
+double largest_ramp_gap(const SceneConfig& scene, double seconds) {
+  Simulation<2> sim(scene);
+  sim.settle();
+  double worst = 0.0;
+  while (sim.time() < seconds) {
+    sim.step();
+    if (sim.steps() % 250 == 0) worst = std::max(worst, ramp_contact(sim.snapshot()).max_gap_m);
+  }
+  return worst;
+}
+
 // The flowing glacier stays on its 45° ramp: over its first 30 s (120 m of advance, more than
 // the ramp is long) the bottom of the ice is never more than 1.5 cells above the ramp (measured:
 // 12.6 m at most, where the ice bends over the lip). A glacier that cannot shear (q_y = 10 MPa,
@@ -77,14 +89,7 @@ TEST(BedContact, FlowingGlacierStaysInContactWithTheRamp) {
   std::ifstream f(std::string(CREVASSE_SOURCE_DIR) + "/studies/scenes/flowing_2d.json");
   const SceneConfig scene = scene_from_json(nlohmann::json::parse(f));
   ASSERT_EQ(scene.step_height, scene.step_length);  // S = 1
-  Simulation<2> sim(scene);
-  sim.settle();
-  double worst = 0.0;
-  while (sim.time() < 30.0) {
-    sim.step();
-    if (sim.steps() % 250 == 0) worst = std::max(worst, ramp_contact(sim.snapshot()).max_gap_m);
-  }
-  EXPECT_LE(worst, 1.5 * scene.dx);
+  EXPECT_LE(largest_ramp_gap(scene, 30.0), 1.5 * scene.dx);
 }
 
 // The same on the quick study's start (studies/quick.json: inflow, whole-volume average, gravity
@@ -99,13 +104,7 @@ TEST(BedContact, WeightDrivenGlacierWithTheWholeVolumeAverageStaysOnTheRamp) {
   j["gravity"]["tilt_deg"] = std::atan(j["bed"]["friction"].get<double>()) * 180.0 / M_PI;
   const SceneConfig scene = scene_from_json(j);
   ASSERT_EQ(scene.step_height, scene.step_length);  // S = 1
-  Simulation<2> sim(scene);
-  sim.settle();
-  double worst = 0.0;
-  while (sim.time() < 40.0) {
-    sim.step();
-    if (sim.steps() % 250 == 0) worst = std::max(worst, ramp_contact(sim.snapshot()).max_gap_m);
-  }
+  const double worst = largest_ramp_gap(scene, 40.0);
   RecordProperty("largest_gap_m", static_cast<int>(worst));
   EXPECT_LE(worst, 1.5 * scene.dx);
 }
