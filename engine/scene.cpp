@@ -313,6 +313,8 @@ const std::vector<FieldSpec>& field_table() {
       boolean_field("numerics", "volumetric_averaging", N, &S::volumetric_averaging),
       written_when(boolean_field("numerics", "average_total_volume", N, &S::average_total_volume),
                    [](const S& s) { return s.average_total_volume; }),
+      written_when(boolean_field("numerics", "average_per_cell", N, &S::average_per_cell),
+                   [](const S& s) { return s.average_per_cell; }),
       number_field("run", "end_time", R, "s", &S::end_time, A, 0, 1e9),
       number_field("run", "front_past_step", R, "m", &S::front_past_step, A, 0, 1e9),
       number_field("run", "gate_length", R, "m", &S::gate_length, X, 0, 1e9),
@@ -420,6 +422,8 @@ void SceneConfig::resolve() {
     fail("effects", "'softening' needs 'plasticity'");
   if (average_total_volume && !volumetric_averaging)
     fail("numerics.average_total_volume", "needs numerics.volumetric_averaging true (it says what the average takes)");
+  if (average_per_cell && !volumetric_averaging)
+    fail("numerics.average_per_cell", "needs numerics.volumetric_averaging true (it says where the average is taken)");
   if (creeps()) {
     if (!has(Effect::plasticity))
       fail("ice.creep.rate_factor", "creep needs the 'plasticity' effect (it relaxes the deviator in the return mapping)");

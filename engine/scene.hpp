@@ -135,6 +135,9 @@ struct SceneNumerics {
   // What the average takes: each step's increment ΔJ (false), or each particle's whole trial
   // elastic volume ratio ΔJ·det F_E (true), which also removes a checkerboard already built up.
   bool average_total_volume = false;
+  // Where the average is taken: over each node's stencil and interpolated back (false), or over
+  // the particles of each grid cell, every particle of a cell taking the cell's mean (true).
+  bool average_per_cell = false;
   // Settling: the discrete MPM equilibrium differs slightly from the analytic geostatic state,
   // so an undamped start rings and puts the top particle layer into tension. Before t = 0 the
   // slab settles elastically (no return mapping, so no plastic strain), with the drive at rest

@@ -137,6 +137,7 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   if (average) {
     add_stage("g2p_velocity", [this] { gather_velocities_and_scatter_volume(); });
     add_stage("volume_averaging", [this] { normalise_volume_average(); });
+    if (scene_.average_per_cell) add_stage("cell_average", [this] { average_over_cells(); });
   }
   if (plastic) {
     // No return mapping while settling: the settled state is elastic by construction.
@@ -419,6 +420,7 @@ void Simulation<Dim>::gather_velocities_and_scatter_volume() {
   auto& P = particles_;
   const double dx = scene_.dx, inv_dx = 1.0 / dx, c_scale = 4.0 * inv_dx * inv_dx;
   const bool damage = averaging_weights_damage();
+  const bool per_cell = scene_.average_per_cell;
   grid_aux_.assign(2 * grid_.node_count(), 0.0);  // per node Σ w m (1−D) ΔJ, then (ΔJ̄, has one)
   double* const aux = grid_aux_.data();
   const std::array<std::size_t, Dim> stride = grid_.strides();
@@ -427,7 +429,7 @@ void Simulation<Dim>::gather_velocities_and_scatter_volume() {
     const StencilWeights<Dim> w(xg);
     const std::size_t f0 = grid_.flat(w.base());
     gather_velocity(p, w, StencilOffsets<Dim>(w, xg, dx), f0, c_scale);
-    const double dj = averaged_volume_ratio(p);
+    const double dj = per_cell ? step_volume_ratio(p) : averaged_volume_ratio(p);
     const double wm = averaging_weight(p, damage);  // the weight P2G added to intact_mass
     for_each_stencil_node<Dim>(w, f0, stride,
                                [&](const IVec<Dim>&, std::size_t f, double wt) { aux[2 * f] += wt * wm * dj; });
@@ -449,12 +451,55 @@ void Simulation<Dim>::normalise_volume_average() {
 }
 
 template <int Dim>
+void Simulation<Dim>::average_over_cells() {
+  // numerics.average_per_cell: each particle's trial elastic volume ratio, its own elastic
+  // volume times the stencil-averaged step ratio, is averaged over the particles of its grid
+  // cell (weights as in the nodal average); the update gives it the cell's mean.
+  auto& P = particles_;
+  const double inv_dx = 1.0 / scene_.dx;
+  const bool damage = averaging_weights_damage();
+  cell_aux_.assign(2 * grid_.node_count(), 0.0);
+  double* const aux = cell_aux_.data();
+  const double* const nodal = grid_aux_.data();
+  for_each_particle_coloured([&](std::uint32_t p) __attribute__((always_inline)) {
+    const Vec<Dim> xg = P.x[p] * inv_dx;
+    const StencilWeights<Dim> w(xg);
+    Vec<2> sums = Vec<2>::Zero();
+    for_each_stencil_node<Dim>(w, grid_.flat(w.base()), grid_.strides(),
+                               [&](const IVec<Dim>&, std::size_t f, double wt) {
+      sums += wt * Eigen::Map<const Vec<2>>(nodal + 2 * f);
+    });
+    const double dj = step_volume_ratio(p);
+    const double share = damage ? softening_[p] : 1.0;
+    const double total = volume_scale_of(sums[0], sums[1], dj, share) * dj * P.F_e[p].determinant();
+    const double wm = averaging_weight(p, damage);
+    const std::size_t c = grid_.flat(cell_of(xg));
+    aux[2 * c] += wm * total;
+    aux[2 * c + 1] += wm;
+  });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid_.node_count(), kGrain), [&](const auto& r) {
+    for (std::size_t f = r.begin(); f != r.end(); ++f) {
+      const bool has = aux[2 * f + 1] > 0.0;
+      aux[2 * f] = has ? aux[2 * f] / aux[2 * f + 1] : 0.0;
+      aux[2 * f + 1] = has ? 1.0 : 0.0;
+    }
+  });
+}
+
+template <int Dim>
 [[gnu::always_inline]] inline typename Simulation<Dim>::VolumeSums Simulation<Dim>::volume_sums(
     std::size_t p, const StencilWeights<Dim>& w) const {
   // The stencil's Σ w ΔJ̄ and Σ w over the nodes that carry an average, from the normalised
   // grid_aux_, and ΔJ_p of particle p (before its update moves it).
   const double* const aux = grid_aux_.data();
   VolumeSums v{0.0, 0.0, 0.0};
+  v.dj = averaged_volume_ratio(p);
+  if (scene_.average_per_cell) {
+    const std::size_t c = grid_.flat(cell_of(particles_.x[p] / scene_.dx));
+    v.jbar = cell_aux_[2 * c];
+    v.wsum = cell_aux_[2 * c + 1];
+    return v;
+  }
   // (Σ w ΔJ̄, Σ w) as one pair: each node's two slots are adjacent, one vector load.
   Vec<2> sums = Vec<2>::Zero();
   for_each_stencil_node<Dim>(w, grid_.flat(w.base()), grid_.strides(),
@@ -463,7 +508,6 @@ template <int Dim>
   });
   v.jbar = sums[0];
   v.wsum = sums[1];
-  v.dj = averaged_volume_ratio(p);
   return v;
 }
 

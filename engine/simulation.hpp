@@ -147,6 +147,9 @@ class Simulation {
   void gather_velocities_and_scatter_volume();
   // Reads grid_aux_'s sums and the nodes' intact_mass; writes grid_aux_'s averages.
   void normalise_volume_average();
+  // numerics.average_per_cell, after normalise_volume_average: per cell the mean trial elastic
+  // volume. Reads grid_aux_, x, C, F_E (softening_); writes cell_aux_.
+  void average_over_cells();
   struct VolumeSums {
     double jbar, wsum, dj;
   };
@@ -158,11 +161,20 @@ class Simulation {
   double averaging_weight(std::size_t p, bool damage) const {
     return particles_.mass[p] * (damage ? softening_[p] : 1.0);
   }
-  // What particle p puts into the average: its step's volume ratio ΔJ = det(I + Δt C), or with
-  // numerics.average_total_volume its whole trial elastic volume ratio ΔJ·det F_E. The update
-  // scales ΔF by (averaged / this)^{1/d} either way.
+  // The grid cell holding grid coordinate xg (its lower corner node).
+  static IVec<Dim> cell_of(const Vec<Dim>& xg) {
+    IVec<Dim> c;
+    for (int a = 0; a < Dim; ++a) c[a] = static_cast<int>(std::floor(xg[a]));
+    return c;
+  }
+  double step_volume_ratio(std::size_t p) const {  // ΔJ = det(I + Δt C)
+    return (Mat<Dim>::Identity() + dt_ * particles_.C[p]).determinant();
+  }
+  // What particle p's volume is averaged as: ΔJ, or with numerics.average_total_volume its whole
+  // trial elastic volume ratio ΔJ·det F_E. The update scales ΔF by (averaged / this)^{1/d}.
+  // (With numerics.average_per_cell the stencil average takes ΔJ and the cell average the rest.)
   double averaged_volume_ratio(std::size_t p) const {
-    const double dj = (Mat<Dim>::Identity() + dt_ * particles_.C[p]).determinant();
+    const double dj = step_volume_ratio(p);
     return scene_.average_total_volume ? dj * particles_.F_e[p].determinant() : dj;
   }
   // G2P's update sweep: the particle update (engine/particle_update.hpp), the per-particle
@@ -210,6 +222,7 @@ class Simulation {
   // Volume averaging scratch (reused every step): per node (Σ w m (1−D) ΔJ, unused), then
   // (averaged ΔJ, whether the node carries one); the weights Σ w m (1−D) are in the grid nodes.
   std::vector<double> grid_aux_;
+  std::vector<double> cell_aux_;  // numerics.average_per_cell: per cell (by its corner node) the mean, has one
   std::vector<double> softening_;  // per particle e^{−ζ ε_v^p} (plastic scenes), from P2G to the update
   std::vector<double> drive_node_mass_;  // per node: mass from the driven layer (drive_grid)
 
