@@ -315,6 +315,8 @@ const std::vector<FieldSpec>& field_table() {
                    [](const S& s) { return s.average_total_volume; }),
       written_when(boolean_field("numerics", "average_per_cell", N, &S::average_per_cell),
                    [](const S& s) { return s.average_per_cell; }),
+      written_when(number_field("numerics", "average_relaxation_time", N, "s", &S::average_relaxation_time, A, 0, 1e6),
+                   [](const S& s) { return s.average_relaxation_time > 0.0; }),
       number_field("run", "end_time", R, "s", &S::end_time, A, 0, 1e9),
       number_field("run", "front_past_step", R, "m", &S::front_past_step, A, 0, 1e9),
       number_field("run", "gate_length", R, "m", &S::gate_length, X, 0, 1e9),
@@ -422,6 +424,8 @@ void SceneConfig::resolve() {
     fail("effects", "'softening' needs 'plasticity'");
   if (average_total_volume && !volumetric_averaging)
     fail("numerics.average_total_volume", "needs numerics.volumetric_averaging true (it says what the average takes)");
+  if (average_relaxation_time > 0.0 && !average_per_cell)
+    fail("numerics.average_relaxation_time", "needs numerics.average_per_cell true (it relaxes the per-cell average)");
   if (average_per_cell && !volumetric_averaging)
     fail("numerics.average_per_cell", "needs numerics.volumetric_averaging true (it says where the average is taken)");
   if (creeps()) {

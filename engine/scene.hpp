@@ -138,6 +138,9 @@ struct SceneNumerics {
   // Where the average is taken: over each node's stencil and interpolated back (false), or over
   // the particles of each grid cell, every particle of a cell taking the cell's mean (true).
   bool average_per_cell = false;
+  // With the per-cell average: each step the cell mean moves the fraction min(1, Δt/τ) towards the
+  // stencil's whole-volume average (τ in seconds of simulated time); 0 = not at all.
+  double average_relaxation_time = 0.0;
   // Settling: the discrete MPM equilibrium differs slightly from the analytic geostatic state,
   // so an undamped start rings and puts the top particle layer into tension. Before t = 0 the
   // slab settles elastically (no return mapping, so no plastic strain), with the drive at rest

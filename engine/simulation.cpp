@@ -423,6 +423,9 @@ void Simulation<Dim>::gather_velocities_and_scatter_volume() {
   const bool per_cell = scene_.average_per_cell;
   grid_aux_.assign(2 * grid_.node_count(), 0.0);  // per node Σ w m (1−D) ΔJ, then (ΔJ̄, has one)
   double* const aux = grid_aux_.data();
+  const bool relax = per_cell && scene_.average_relaxation_time > 0.0;
+  grid_total_.assign(relax ? grid_.node_count() : 0, 0.0);
+  double* const total = grid_total_.data();
   const std::array<std::size_t, Dim> stride = grid_.strides();
   for_each_particle_coloured([&](std::uint32_t p) __attribute__((always_inline)) {
     const Vec<Dim> xg = P.x[p] * inv_dx;
@@ -431,6 +434,14 @@ void Simulation<Dim>::gather_velocities_and_scatter_volume() {
     gather_velocity(p, w, StencilOffsets<Dim>(w, xg, dx), f0, c_scale);
     const double dj = per_cell ? step_volume_ratio(p) : averaged_volume_ratio(p);
     const double wm = averaging_weight(p, damage);  // the weight P2G added to intact_mass
+    if (relax) {
+      const double jt = dj * P.F_e[p].determinant();
+      for_each_stencil_node<Dim>(w, f0, stride, [&](const IVec<Dim>&, std::size_t f, double wt) {
+        aux[2 * f] += wt * wm * dj;
+        total[f] += wt * wm * jt;
+      });
+      return;
+    }
     for_each_stencil_node<Dim>(w, f0, stride,
                                [&](const IVec<Dim>&, std::size_t f, double wt) { aux[2 * f] += wt * wm * dj; });
   });
@@ -446,6 +457,7 @@ void Simulation<Dim>::normalise_volume_average() {
       const bool has = intact > 1e-9 * grid_.nodes[f].mass;
       grid_aux_[2 * f] = has ? grid_aux_[2 * f] / intact : 0.0;
       grid_aux_[2 * f + 1] = has ? 1.0 : 0.0;
+      if (!grid_total_.empty()) grid_total_[f] = has ? grid_total_[f] / intact : 0.0;
     }
   });
 }
@@ -461,17 +473,22 @@ void Simulation<Dim>::average_over_cells() {
   cell_aux_.assign(2 * grid_.node_count(), 0.0);
   double* const aux = cell_aux_.data();
   const double* const nodal = grid_aux_.data();
+  const bool relax = !grid_total_.empty();
+  stencil_total_.resize(relax ? P.size() : 0);
   for_each_particle_coloured([&](std::uint32_t p) __attribute__((always_inline)) {
     const Vec<Dim> xg = P.x[p] * inv_dx;
     const StencilWeights<Dim> w(xg);
     Vec<2> sums = Vec<2>::Zero();
+    double st = 0.0;
     for_each_stencil_node<Dim>(w, grid_.flat(w.base()), grid_.strides(),
                                [&](const IVec<Dim>&, std::size_t f, double wt) {
       sums += wt * Eigen::Map<const Vec<2>>(nodal + 2 * f);
+      if (relax) st += wt * grid_total_[f];
     });
     const double dj = step_volume_ratio(p);
     const double share = damage ? softening_[p] : 1.0;
     const double total = volume_scale_of(sums[0], sums[1], dj, share) * dj * P.F_e[p].determinant();
+    if (relax) stencil_total_[p] = sums[1] > 0.0 ? st / sums[1] : total;
     const double wm = averaging_weight(p, damage);
     const std::size_t c = grid_.flat(cell_of(xg));
     aux[2 * c] += wm * total;
@@ -498,6 +515,11 @@ template <int Dim>
     const std::size_t c = grid_.flat(cell_of(particles_.x[p] / scene_.dx));
     v.jbar = cell_aux_[2 * c];
     v.wsum = cell_aux_[2 * c + 1];
+    if (!stencil_total_.empty()) {
+      // Relaxed towards the stencil's whole-volume average at the rate 1/τ.
+      const double a = std::min(1.0, dt_ / scene_.average_relaxation_time);
+      v.jbar = (1.0 - a) * v.jbar + a * stencil_total_[p];
+    }
     return v;
   }
   // (Σ w ΔJ̄, Σ w) as one pair: each node's two slots are adjacent, one vector load.

@@ -222,6 +222,8 @@ class Simulation {
   // Volume averaging scratch (reused every step): per node (Σ w m (1−D) ΔJ, unused), then
   // (averaged ΔJ, whether the node carries one); the weights Σ w m (1−D) are in the grid nodes.
   std::vector<double> grid_aux_;
+  std::vector<double> grid_total_;     // average_relaxation_time: per node the stencil's whole volume
+  std::vector<double> stencil_total_;  // and per particle its interpolation
   std::vector<double> cell_aux_;  // numerics.average_per_cell: per cell (by its corner node) the mean, has one
   std::vector<double> softening_;  // per particle e^{−ζ ε_v^p} (plastic scenes), from P2G to the update
   std::vector<double> drive_node_mass_;  // per node: mass from the driven layer (drive_grid)

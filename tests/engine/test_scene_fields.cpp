@@ -107,6 +107,7 @@ TEST(SceneFields, EachKeyReachesItsOwnMember) {
       {"numerics.jitter", [](const SceneConfig& s) { return s.jitter; }},
       {"numerics.seed", [](const SceneConfig& s) { return static_cast<double>(s.seed); }},
       {"numerics.top_margin", [](const SceneConfig& s) { return s.top_margin; }},
+      {"numerics.average_relaxation_time", [](const SceneConfig& s) { return s.average_relaxation_time; }},
       {"run.end_time", [](const SceneConfig& s) { return s.end_time; }},
       {"run.front_past_step", [](const SceneConfig& s) { return s.front_past_step; }},
       {"run.gate_length", [](const SceneConfig& s) { return s.gate_length; }},
@@ -131,6 +132,8 @@ TEST(SceneFields, EachKeyReachesItsOwnMember) {
   // A scene without creep writes no creep section (its case hash stays that of the law without it).
   EXPECT_FALSE(j["ice"].contains("creep"));
   j["ice"]["creep"] = {{"rate_factor", 2.4e-24}, {"exponent", 3.0}, {"field_speed", 3.17e-6}};
+  j["numerics"]["average_per_cell"] = true;  // written only when set, like the creep section
+  j["numerics"]["average_relaxation_time"] = 0.05;
   const auto pointer = [](std::string path) {
     for (char& c : path)
       if (c == '.') c = '/';
