@@ -92,15 +92,16 @@ TEST(BedContact, FlowingGlacierStaysInContactWithTheRamp) {
   EXPECT_LE(largest_ramp_gap(scene, 30.0), 1.5 * scene.dx);
 }
 
-// The same on the quick study's start (studies/scenes/flowing_weight_2d.json: inflow, whole-volume
-// average, gravity tilted by atan μ_b so that the ice's weight carries it) over its 45° ramp,
+// The same on the quick study's start (studies/scenes/flowing_weight_cell_2d.json: inflow, relaxed
+// per-cell whole-volume average, gravity tilted by atan μ_b so that the ice's weight carries it) over its 45° ramp,
 // H_i = 100 m, q_y = 0.5 ρ_i g H_i: over 40 s (160 m of advance) the bottom of the ice stays
 // within 1.5 cells of the ramp.
 TEST(BedContact, WeightDrivenGlacierWithTheWholeVolumeAverageStaysOnTheRamp) {
-  std::ifstream f(std::string(CREVASSE_SOURCE_DIR) + "/studies/scenes/flowing_weight_2d.json");
+  std::ifstream f(std::string(CREVASSE_SOURCE_DIR) + "/studies/scenes/flowing_weight_cell_2d.json");
   const SceneConfig scene = scene_from_json(nlohmann::json::parse(f));
   ASSERT_EQ(scene.step_height, scene.step_length);  // S = 1
   ASSERT_TRUE(scene.average_total_volume);
+  ASSERT_TRUE(scene.average_per_cell);
   ASSERT_NEAR(std::tan(scene.gravity_tilt_deg * M_PI / 180.0), scene.bed_friction, 1e-12);
   const double worst = largest_ramp_gap(scene, 40.0);
   RecordProperty("largest_gap_m", static_cast<int>(worst));

@@ -72,14 +72,15 @@ TEST(FlowingGlacier, DrapedGlacierWithoutDriveShowsNoDamageAfterSettling) {
   expect_nothing_opens_in_20_s(scene);
 }
 
-// The same on the quick study's start (studies/scenes/flowing_weight_2d.json: the inflow scene
-// with the whole-volume average) at rest: inflow speed 0, gravity not tilted, so nothing drives it.
+// The same on the quick study's start (studies/scenes/flowing_weight_cell_2d.json: the inflow
+// scene with the relaxed per-cell whole-volume average) at rest: inflow speed 0, gravity not tilted, so nothing drives it.
 TEST(FlowingGlacier, InflowGlacierWithTheWholeVolumeAverageShowsNoDamageAtRest) {
-  nlohmann::json j = test::shipped_scene_json("flowing_weight_2d.json");
+  nlohmann::json j = test::shipped_scene_json("flowing_weight_cell_2d.json");
   j["drive"]["speed"] = 0.0;
   j["gravity"]["tilt_deg"] = 0.0;
   const SceneConfig scene = scene_from_json(j);
   ASSERT_TRUE(scene.average_total_volume);
+  ASSERT_TRUE(scene.average_per_cell);
   expect_nothing_opens_in_20_s(scene);
 }
 
