@@ -1,9 +1,10 @@
-// bench_case [STEPS] [THICKNESS]: the production case's throughput, as a study runs it. The case
-// is the one of studies/whole_case_cost.json with that H_i (default 400 m: the flowing glacier
-// at dx = 10 m, fed by its inflow, no ΔJ-bar average), read through the study loader so that
-// it is exactly the case the study runs. After one settling, saved and reloaded from a
-// checkpoint, it times STEPS steps (default 400):
-//   (a) one case on 1 and on 2 engine threads, in particle-steps per second;
+// bench_case [STEPS] [THICKNESS] [STUDY]: the production case's throughput, as a study runs it.
+// The case is the one of STUDY (default studies/whole_case_cost.json, the flowing glacier at
+// dx = 10 m with the quick study's numerics) with that H_i (default 400 m), read through the
+// study loader so that it is exactly the case the study runs. After one settling, saved and
+// reloaded from a checkpoint, it times STEPS steps (default 400):
+//   (a) one case on 1 and on 2 engine threads, in particle-steps per second, and how the
+//       2-thread step splits over the engine's stages;
 //   (c) two cases at once, one engine thread each, against one case on one thread;
 // and the resident memory of one case per particle. The whole-case wall times are those of the
 // study itself (results/whole_case_cost.db; docs/performance.md).
@@ -43,7 +44,8 @@ double resident_bytes() {
 
 // Steps a simulation restored from the settled checkpoint on `threads` engine threads; returns
 // particle-steps per second.
-double run(const SceneConfig& scene, const std::string& checkpoint, long steps, int threads) {
+double run(const SceneConfig& scene, const std::string& checkpoint, long steps, int threads,
+           bool print_stages = false) {
   tbb::task_arena arena(threads);
   double rate = 0.0;
   arena.execute([&] {
@@ -54,6 +56,11 @@ double run(const SceneConfig& scene, const std::string& checkpoint, long steps, 
     for (long s = 0; s < steps; ++s) sim.step();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     rate = static_cast<double>(sim.particle_steps() - before) / wall;
+    if (!print_stages) return;
+    // The stage clocks restart with the restored simulation: they cover exactly these steps.
+    for (const auto& st : sim.stages())
+      std::printf("    %-22s %5.1f %%  %7.1f ns/particle-step\n", st.name.c_str(), 100.0 * st.seconds / wall,
+                  1e9 * st.seconds / static_cast<double>(sim.particle_steps() - before));
   });
   return rate;
 }
@@ -63,13 +70,15 @@ double run(const SceneConfig& scene, const std::string& checkpoint, long steps, 
 int main(int argc, char** argv) {
   const long steps = argc > 1 ? std::stol(argv[1]) : 400;
   const double thickness = argc > 2 ? std::stod(argv[2]) : 400.0;
-  const crevasse::Study study =
-      crevasse::load_study_file(std::filesystem::path(CREVASSE_SOURCE_DIR) / "studies/whole_case_cost.json");
+  const std::filesystem::path study_file =
+      argc > 3 ? std::filesystem::path(argv[3])
+               : std::filesystem::path(CREVASSE_SOURCE_DIR) / "studies/whole_case_cost.json";
+  const crevasse::Study study = crevasse::load_study_file(study_file);
   const crevasse::StudyCase* chosen = nullptr;
   for (const auto& c : study.cases)
     if (c.scene.ice_thickness == thickness) chosen = &c;
   if (!chosen) {
-    std::fprintf(stderr, "bench_case: studies/whole_case_cost.json has no case with H_i = %g m\n", thickness);
+    std::fprintf(stderr, "bench_case: %s has no case with H_i = %g m\n", study_file.string().c_str(), thickness);
     return 2;
   }
   const SceneConfig& scene = chosen->scene;
@@ -94,8 +103,9 @@ int main(int argc, char** argv) {
   std::printf("memory: %.0f B resident per particle (one case, after its first step)\n", bytes_per_particle);
 
   const double one = run(scene, checkpoint, steps, 1);
-  const double two_threads = run(scene, checkpoint, steps, 2);
   std::printf("(a) one case, 1 thread : %6.2f M particle-steps/s\n", one / 1e6);
+  std::printf("(a) one case, 2 threads, by stage:\n");
+  const double two_threads = run(scene, checkpoint, steps, 2, true);
   std::printf("(a) one case, 2 threads: %6.2f M particle-steps/s (x%.2f)\n", two_threads / 1e6, two_threads / one);
   double a = 0.0, b = 0.0;
   std::thread first([&] { a = run(scene, checkpoint, steps, 1); });

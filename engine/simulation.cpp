@@ -421,11 +421,10 @@ void Simulation<Dim>::gather_velocities_and_scatter_volume() {
   const double dx = scene_.dx, inv_dx = 1.0 / dx, c_scale = 4.0 * inv_dx * inv_dx;
   const bool damage = averaging_weights_damage();
   const bool per_cell = scene_.average_per_cell;
-  grid_aux_.assign(2 * grid_.node_count(), 0.0);  // per node Σ w m (1−D) ΔJ, then (ΔJ̄, has one)
+  grid_aux_.assign(2 * grid_.node_count(), 0.0);  // per node Σ w m (1−D) ΔJ (and ΔJ J_E), then (ΔJ̄, has one)
   double* const aux = grid_aux_.data();
   const bool relax = per_cell && scene_.average_relaxation_time > 0.0;
-  grid_total_.assign(relax ? grid_.node_count() : 0, 0.0);
-  double* const total = grid_total_.data();
+  grid_total_.resize(relax ? grid_.node_count() : 0);  // written by normalise_volume_average
   const std::array<std::size_t, Dim> stride = grid_.strides();
   for_each_particle_coloured([&](std::uint32_t p) __attribute__((always_inline)) {
     const Vec<Dim> xg = P.x[p] * inv_dx;
@@ -435,10 +434,11 @@ void Simulation<Dim>::gather_velocities_and_scatter_volume() {
     const double dj = per_cell ? step_volume_ratio(p) : averaged_volume_ratio(p);
     const double wm = averaging_weight(p, damage);  // the weight P2G added to intact_mass
     if (relax) {
+      // The whole volume's sum goes in each node's second slot, free until the normalisation.
       const double jt = dj * P.F_e[p].determinant();
       for_each_stencil_node<Dim>(w, f0, stride, [&](const IVec<Dim>&, std::size_t f, double wt) {
         aux[2 * f] += wt * wm * dj;
-        total[f] += wt * wm * jt;
+        aux[2 * f + 1] += wt * wm * jt;
       });
       return;
     }
@@ -455,9 +455,9 @@ void Simulation<Dim>::normalise_volume_average() {
     for (std::size_t f = r.begin(); f != r.end(); ++f) {
       const double intact = grid_.nodes[f].intact_mass;
       const bool has = intact > 1e-9 * grid_.nodes[f].mass;
+      if (!grid_total_.empty()) grid_total_[f] = has ? grid_aux_[2 * f + 1] / intact : 0.0;
       grid_aux_[2 * f] = has ? grid_aux_[2 * f] / intact : 0.0;
       grid_aux_[2 * f + 1] = has ? 1.0 : 0.0;
-      if (!grid_total_.empty()) grid_total_[f] = has ? grid_total_[f] / intact : 0.0;
     }
   });
 }
@@ -472,23 +472,13 @@ void Simulation<Dim>::average_over_cells() {
   const bool damage = averaging_weights_damage();
   cell_aux_.assign(2 * grid_.node_count(), 0.0);
   double* const aux = cell_aux_.data();
-  const double* const nodal = grid_aux_.data();
-  const bool relax = !grid_total_.empty();
-  stencil_total_.resize(relax ? P.size() : 0);
   for_each_particle_coloured([&](std::uint32_t p) __attribute__((always_inline)) {
     const Vec<Dim> xg = P.x[p] * inv_dx;
     const StencilWeights<Dim> w(xg);
-    Vec<2> sums = Vec<2>::Zero();
-    double st = 0.0;
-    for_each_stencil_node<Dim>(w, grid_.flat(w.base()), grid_.strides(),
-                               [&](const IVec<Dim>&, std::size_t f, double wt) {
-      sums += wt * Eigen::Map<const Vec<2>>(nodal + 2 * f);
-      if (relax) st += wt * grid_total_[f];
-    });
+    const Vec<2> sums = stencil_sums(w);
     const double dj = step_volume_ratio(p);
     const double share = damage ? softening_[p] : 1.0;
     const double total = volume_scale_of(sums[0], sums[1], dj, share) * dj * P.F_e[p].determinant();
-    if (relax) stencil_total_[p] = sums[1] > 0.0 ? st / sums[1] : total;
     const double wm = averaging_weight(p, damage);
     const std::size_t c = grid_.flat(cell_of(xg));
     aux[2 * c] += wm * total;
@@ -504,30 +494,47 @@ void Simulation<Dim>::average_over_cells() {
 }
 
 template <int Dim>
+[[gnu::always_inline]] inline Vec<2> Simulation<Dim>::stencil_sums(const StencilWeights<Dim>& w,
+                                                                   double* total) const {
+  // (Σ w ΔJ̄, Σ w) over the stencil's nodes that carry an average, from the normalised
+  // grid_aux_ (each node's two slots adjacent: one vector load), and Σ w T̄ from grid_total_
+  // when `total` is given.
+  const double* const aux = grid_aux_.data();
+  const double* const nodal_total = grid_total_.data();
+  Vec<2> sums = Vec<2>::Zero();
+  double st = 0.0;
+  for_each_stencil_node<Dim>(w, grid_.flat(w.base()), grid_.strides(),
+                             [&](const IVec<Dim>&, std::size_t f, double wt) {
+    sums += wt * Eigen::Map<const Vec<2>>(aux + 2 * f);
+    if (total) st += wt * nodal_total[f];
+  });
+  if (total) *total = st;
+  return sums;
+}
+
+template <int Dim>
 [[gnu::always_inline]] inline typename Simulation<Dim>::VolumeSums Simulation<Dim>::volume_sums(
     std::size_t p, const StencilWeights<Dim>& w) const {
-  // The stencil's Σ w ΔJ̄ and Σ w over the nodes that carry an average, from the normalised
-  // grid_aux_, and ΔJ_p of particle p (before its update moves it).
-  const double* const aux = grid_aux_.data();
+  // The stencil's Σ w ΔJ̄ and Σ w, or with numerics.average_per_cell the cell's mean and
+  // whether it has one, and ΔJ_p of particle p (before its update moves it).
   VolumeSums v{0.0, 0.0, 0.0};
   v.dj = averaged_volume_ratio(p);
   if (scene_.average_per_cell) {
     const std::size_t c = grid_.flat(cell_of(particles_.x[p] / scene_.dx));
     v.jbar = cell_aux_[2 * c];
     v.wsum = cell_aux_[2 * c + 1];
-    if (!stencil_total_.empty()) {
-      // Relaxed towards the stencil's whole-volume average at the rate 1/τ.
+    if (!grid_total_.empty()) {
+      // Relaxed towards the stencil's whole-volume average at the rate 1/τ (a particle whose
+      // stencil carries none, towards its own).
+      double st = 0.0;
+      const double wsum = stencil_sums(w, &st)[1];
+      const double target = wsum > 0.0 ? st / wsum : v.dj;
       const double a = std::min(1.0, dt_ / scene_.average_relaxation_time);
-      v.jbar = (1.0 - a) * v.jbar + a * stencil_total_[p];
+      v.jbar = (1.0 - a) * v.jbar + a * target;
     }
     return v;
   }
-  // (Σ w ΔJ̄, Σ w) as one pair: each node's two slots are adjacent, one vector load.
-  Vec<2> sums = Vec<2>::Zero();
-  for_each_stencil_node<Dim>(w, grid_.flat(w.base()), grid_.strides(),
-                             [&](const IVec<Dim>&, std::size_t f, double wt) {
-    sums += wt * Eigen::Map<const Vec<2>>(aux + 2 * f);
-  });
+  const Vec<2> sums = stencil_sums(w);
   v.jbar = sums[0];
   v.wsum = sums[1];
   return v;

@@ -148,12 +148,14 @@ class Simulation {
   // Reads grid_aux_'s sums and the nodes' intact_mass; writes grid_aux_'s averages.
   void normalise_volume_average();
   // numerics.average_per_cell, after normalise_volume_average: per cell the mean trial elastic
-  // volume. Reads grid_aux_, x, C, F_E (softening_); writes cell_aux_.
+  // volume. Reads grid_aux_, x, C, F_E (softening_); writes cell_aux_. The relaxation's target,
+  // the stencil's whole-volume average, is interpolated by the update sweep (volume_sums).
   void average_over_cells();
   struct VolumeSums {
     double jbar, wsum, dj;
   };
   VolumeSums volume_sums(std::size_t p, const StencilWeights<Dim>& w) const;
+  Vec<2> stencil_sums(const StencilWeights<Dim>& w, double* total = nullptr) const;
   bool averaging_weights_damage() const;  // the averaging weights each particle by 1 − D
   // A particle's weight in the ΔJ-bar average, m (1 − D) when it weights damage (then softening_
   // holds 1 − D = e^{−ζ ε_v^p}, set by P2G), m otherwise: P2G adds it to the nodes' intact_mass
@@ -219,11 +221,11 @@ class Simulation {
   std::vector<std::uint32_t> slab_order_;
   std::vector<std::uint32_t> slab_start_;
   std::vector<std::uint32_t> slab_block_offsets_;
-  // Volume averaging scratch (reused every step): per node (Σ w m (1−D) ΔJ, unused), then
-  // (averaged ΔJ, whether the node carries one); the weights Σ w m (1−D) are in the grid nodes.
+  // Volume averaging scratch (reused every step): per node (Σ w m (1−D) ΔJ, unused or with the
+  // relaxed per-cell average Σ w m (1−D) ΔJ J_E), then (averaged ΔJ, whether the node carries
+  // one); the weights Σ w m (1−D) are in the grid nodes.
   std::vector<double> grid_aux_;
-  std::vector<double> grid_total_;     // average_relaxation_time: per node the stencil's whole volume
-  std::vector<double> stencil_total_;  // and per particle its interpolation
+  std::vector<double> grid_total_;  // average_relaxation_time: per node the stencil's whole volume
   std::vector<double> cell_aux_;  // numerics.average_per_cell: per cell (by its corner node) the mean, has one
   std::vector<double> softening_;  // per particle e^{−ζ ε_v^p} (plastic scenes), from P2G to the update
   std::vector<double> drive_node_mass_;  // per node: mass from the driven layer (drive_grid)
