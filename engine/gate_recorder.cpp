@@ -30,8 +30,9 @@ void GateRecorder<Dim>::record(Particles<Dim>& P) {
 }
 
 template <int Dim>
-void GateRecorder<Dim>::archive_removed(const Particles<Dim>& P, const std::vector<char>& keep) {
-  for (std::size_t p = 0; p < P.size(); ++p) {
+void GateRecorder<Dim>::archive_removed(const Particles<Dim>& P, const std::vector<char>& keep,
+                                        std::size_t first) {
+  for (std::size_t p = first; p < P.size(); ++p) {
     if (keep[p] || P.gate_eps[p] < 0.0f) continue;
     archive_.x.push_back(P.x_ref[p]);
     archive_.eps.push_back(P.gate_eps[p]);

@@ -32,7 +32,7 @@ class GateRecorder {
   // Records the particles that have reached the gate since the last call.
   void record(Particles<Dim>& P);
   // Archives the records of the particles about to be removed (keep[p] == 0).
-  void archive_removed(const Particles<Dim>& P, const std::vector<char>& keep);
+  void archive_removed(const Particles<Dim>& P, const std::vector<char>& keep, std::size_t first = 0);
   // The records of a particle entering through the inflow at `pos`, the drive having moved by
   // `drive_shift` since t = 0.
   static void add_entering(Particles<Dim>& P, const Vec<Dim>& pos, double drive_shift);

@@ -64,12 +64,13 @@ struct Particles {
     if (!x_ref.empty()) { apply(x_ref); apply(gate_eps); }
   }
 
-  // Keeps the particles with keep[i] true, in order (in place); returns the mass removed.
-  double compact(const std::vector<char>& keep) {
+  // Keeps the particles with keep[i] true, in order (in place); returns the mass removed. Every
+  // particle before `first` is kept.
+  double compact(const std::vector<char>& keep, std::size_t first = 0) {
     double removed = 0.0;
-    for (std::size_t i = 0; i < size(); ++i)
+    for (std::size_t i = first; i < size(); ++i)
       if (!keep[i]) removed += mass[i];
-    const auto apply = [&](auto& a) { compact_in_place(a, keep); };
+    const auto apply = [&](auto& a) { compact_in_place(a, keep, first); };
     apply(x); apply(v); apply(C); apply(F_e); apply(tau); apply(mass); apply(vol0);
     if (has_plastic_state()) apply(eps_v_p);
     if (!drive_x0.empty()) apply(drive_x0);
@@ -101,9 +102,9 @@ struct Particles {
     }
   }
   template <class T>
-  static void compact_in_place(std::vector<T>& a, const std::vector<char>& keep) {
-    std::size_t k = 0;
-    for (std::size_t i = 0; i < a.size(); ++i)
+  static void compact_in_place(std::vector<T>& a, const std::vector<char>& keep, std::size_t first) {
+    std::size_t k = first;
+    for (std::size_t i = first; i < a.size(); ++i)
       if (keep[i]) a[k++] = a[i];
     a.resize(k);
   }

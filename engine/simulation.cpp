@@ -619,19 +619,25 @@ void Simulation<Dim>::remove_outflow() {
   // Ice within three cells of the downstream end has left the scene (docs/model.md).
   const double x_out = domain_hi_[0] - 3.0 * scene_.dx;
   auto& P = particles_;
-  // Most steps remove nothing: look first (in parallel), allocate the mask only when needed.
-  const bool any = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, P.size(), kGrain), false,
-      [&](const auto& r, bool found) {
-        for (std::size_t p = r.begin(); p != r.end() && !found; ++p) found = !(P.x[p][0] < x_out);
+  // Most steps remove nothing. The update's summary holds the front (its largest x), so those
+  // steps cost nothing; otherwise find the first particle past the line. The particles are
+  // sorted with x slowest, so those past it sit near the end and everything before the first
+  // stays where it is.
+  if (summary_step_ == steps_ && summary_.bad < 0 && summary_.front < x_out) return;
+  const std::size_t n = P.size();
+  const std::size_t first = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, n, kGrain), n,
+      [&](const auto& r, std::size_t found) {
+        for (std::size_t p = r.begin(); p != r.end() && p < found; ++p)
+          if (!(P.x[p][0] < x_out)) found = p;
         return found;
       },
-      [](bool a, bool b) { return a || b; });
-  if (!any) return;
-  std::vector<char> keep(P.size());
-  for (std::size_t p = 0; p < P.size(); ++p) keep[p] = P.x[p][0] < x_out;
-  if (records_gate()) gate_.archive_removed(P, keep);
-  removed_mass_ += P.compact(keep);
+      [](std::size_t a, std::size_t b) { return std::min(a, b); });
+  if (first == n) return;
+  std::vector<char> keep(n, 1);
+  for (std::size_t p = first; p < n; ++p) keep[p] = P.x[p][0] < x_out;
+  if (records_gate()) gate_.archive_removed(P, keep, first);
+  removed_mass_ += P.compact(keep, first);
   summary_step_ = -1;  // the update's summary counted the removed particles
 }
 

@@ -106,6 +106,27 @@ TEST(ParticlesReorder, CompactInPlaceKeepsOrderAndCountsTheMass) {
   }
 }
 
+// The outflow compacts from the first particle it removes: the kept prefix is not touched, and
+// the result is the whole compaction's.
+TEST(ParticlesReorder, CompactFromTheFirstRemovedEqualsTheWholeCompaction) {
+  std::mt19937 rng(12);
+  std::bernoulli_distribution coin(0.3);
+  const Particles<2> ref = numbered_particles(500, true);
+  std::vector<char> keep(ref.size(), 1);
+  std::vector<std::uint32_t> kept;
+  double removed = 0.0;
+  const std::size_t first = 400;
+  for (std::size_t i = 0; i < keep.size(); ++i) {
+    if (i >= first) keep[i] = coin(rng);
+    if (keep[i]) kept.push_back(static_cast<std::uint32_t>(i));
+    else removed += ref.mass[i];
+  }
+  ASSERT_FALSE(keep[first] && removed == 0.0);
+  Particles<2> P = ref;
+  EXPECT_EQ(P.compact(keep, first), removed);
+  expect_reordered(P, ref, kept);
+}
+
 template <class T>
 bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
   return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
