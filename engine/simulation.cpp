@@ -484,31 +484,30 @@ void Simulation<Dim>::average_over_cells() {
     aux[2 * c] += wm * total;
     aux[2 * c + 1] += wm;
   });
+  // The nodes' ΔJ̄ has served; with the relaxation, their whole-volume average takes its slot,
+  // beside the flag the update needs with it.
+  const bool relax = !grid_total_.empty();
+  double* const nodal = grid_aux_.data();
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid_.node_count(), kGrain), [&](const auto& r) {
     for (std::size_t f = r.begin(); f != r.end(); ++f) {
       const bool has = aux[2 * f + 1] > 0.0;
       aux[2 * f] = has ? aux[2 * f] / aux[2 * f + 1] : 0.0;
       aux[2 * f + 1] = has ? 1.0 : 0.0;
+      if (relax) nodal[2 * f] = grid_total_[f];
     }
   });
 }
 
 template <int Dim>
-[[gnu::always_inline]] inline Vec<2> Simulation<Dim>::stencil_sums(const StencilWeights<Dim>& w,
-                                                                   double* total) const {
-  // (Σ w ΔJ̄, Σ w) over the stencil's nodes that carry an average, from the normalised
-  // grid_aux_ (each node's two slots adjacent: one vector load), and Σ w T̄ from grid_total_
-  // when `total` is given.
+[[gnu::always_inline]] inline Vec<2> Simulation<Dim>::stencil_sums(const StencilWeights<Dim>& w) const {
+  // (Σ w·first, Σ w·flag) over the stencil from grid_aux_'s pairs (each node's two slots
+  // adjacent: one vector load per node).
   const double* const aux = grid_aux_.data();
-  const double* const nodal_total = grid_total_.data();
   Vec<2> sums = Vec<2>::Zero();
-  double st = 0.0;
   for_each_stencil_node<Dim>(w, grid_.flat(w.base()), grid_.strides(),
                              [&](const IVec<Dim>&, std::size_t f, double wt) {
     sums += wt * Eigen::Map<const Vec<2>>(aux + 2 * f);
-    if (total) st += wt * nodal_total[f];
   });
-  if (total) *total = st;
   return sums;
 }
 
@@ -526,9 +525,8 @@ template <int Dim>
     if (!grid_total_.empty()) {
       // Relaxed towards the stencil's whole-volume average at the rate 1/τ (a particle whose
       // stencil carries none, towards its own).
-      double st = 0.0;
-      const double wsum = stencil_sums(w, &st)[1];
-      const double target = wsum > 0.0 ? st / wsum : v.dj;
+      const Vec<2> st = stencil_sums(w);  // grid_aux_ holds (T̄, has one) now
+      const double target = st[1] > 0.0 ? st[0] / st[1] : v.dj;
       const double a = std::min(1.0, dt_ / scene_.average_relaxation_time);
       v.jbar = (1.0 - a) * v.jbar + a * target;
     }

@@ -148,14 +148,15 @@ class Simulation {
   // Reads grid_aux_'s sums and the nodes' intact_mass; writes grid_aux_'s averages.
   void normalise_volume_average();
   // numerics.average_per_cell, after normalise_volume_average: per cell the mean trial elastic
-  // volume. Reads grid_aux_, x, C, F_E (softening_); writes cell_aux_. The relaxation's target,
-  // the stencil's whole-volume average, is interpolated by the update sweep (volume_sums).
+  // volume. Reads grid_aux_, x, C, F_E (softening_); writes cell_aux_. With the relaxation it
+  // then puts the nodes' whole-volume average (grid_total_) in grid_aux_'s first slots, where
+  // the update sweep interpolates its target (volume_sums).
   void average_over_cells();
   struct VolumeSums {
     double jbar, wsum, dj;
   };
   VolumeSums volume_sums(std::size_t p, const StencilWeights<Dim>& w) const;
-  Vec<2> stencil_sums(const StencilWeights<Dim>& w, double* total = nullptr) const;
+  Vec<2> stencil_sums(const StencilWeights<Dim>& w) const;
   bool averaging_weights_damage() const;  // the averaging weights each particle by 1 − D
   // A particle's weight in the ΔJ-bar average, m (1 − D) when it weights damage (then softening_
   // holds 1 − D = e^{−ζ ε_v^p}, set by P2G), m otherwise: P2G adds it to the nodes' intact_mass
