@@ -55,7 +55,7 @@ def load(db):
     con = sqlite3.connect(f"file:{db}?mode=ro", uri=True)
     rows = con.execute(
         "SELECT c.case_id, c.axes_json, c.thickness_m, c.wall_s, s.spacing_median_over_h,"
-        " s.depth_median_over_h, s.crevasse_count, s.spacings_json, s.settings_json"
+        " s.depth_median_over_h, s.crevasse_count, s.spacings_json, s.settings_json, c.cohesion_ratio"
         " FROM cases c JOIN summaries s USING(case_id) WHERE c.status = 'done'").fetchall()
     depths = {}
     for case_id, d in con.execute("SELECT case_id, depth_over_h FROM crevasses"):
@@ -81,9 +81,10 @@ def main():
         rows += db_rows
         depths.update(db_depths)
     groups = {}
-    for case_id, axes_json, h, wall, sp, dp, count, spacings_json, settings_json in rows:
+    for case_id, axes_json, h, wall, sp, dp, count, spacings_json, settings_json, pi in rows:
         axes = json.loads(axes_json)
-        group = axes.pop(args.group, None)
+        # A study that fixes Π instead of sweeping it is one group, at its Π.
+        group = axes.pop(args.group, pi if args.group == "cohesion_ratio" else None)
         axes.pop("replica", None)
         missing = [k for k in ref if k not in axes]
         if missing:
