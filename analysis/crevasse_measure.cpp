@@ -74,8 +74,12 @@ struct Candidate {
 }  // namespace
 
 bool uses_gate_frame(const ParticleSnapshot& snapshot, const MeasureSettings& settings) {
-  require(settings.frame == "auto" || settings.frame == "gate" || settings.frame == "final",
-          "frame must be 'auto', 'gate' or 'final', got '" + settings.frame + "'");
+  require(settings.frame == "auto" || settings.frame == "gate" || settings.frame == "final" ||
+              settings.frame == "passed",
+          "frame must be 'auto', 'gate', 'final' or 'passed', got '" + settings.frame + "'");
+  if (settings.frame == "passed")
+    require(snapshot.upstream_ice_front_x_m > 0.0 || snapshot.size() == 0,
+            "frame 'passed' needs a snapshot that knows where the ice came from (a slab scene with a gate)");
   if (settings.frame == "gate")
     require(snapshot.has_gate(), "frame 'gate' needs a snapshot with gate records (a slab on a "
                                  "step or concave bed, with plasticity)");
@@ -160,6 +164,10 @@ ResolvedMeasureSettings resolve_in_frame(const ParticleSnapshot& snapshot,
           "fragmented_fraction must lie in (0, 1], got " +
               std::to_string(settings.fragmented_fraction));
   r.resolution_floor_m = settings.resolution_floor_over_dx * r.dx_m;
+  if (settings.spacing_rule != "merge" && settings.spacing_rule != "drop")
+    throw std::invalid_argument("spacing_rule: value \"" + settings.spacing_rule +
+                                "\" is not \"merge\" or \"drop\"");
+  r.spacing_rule = settings.spacing_rule;
   r.min_depth_m = settings.min_depth_over_dx * r.dx_m;
   r.link_distance_m = settings.link_distance_over_spacing * r.particle_spacing_m;
   r.surface_reach_m = settings.surface_reach_over_dx * r.dx_m;
@@ -172,8 +180,11 @@ ResolvedMeasureSettings resolve_in_frame(const ParticleSnapshot& snapshot,
 
   const double margin = settings.window_margin_over_h * r.ice_thickness_m;
   r.window_explicit = settings.window_min_x_m.has_value() || settings.window_max_x_m.has_value();
-  r.frame = gate ? "gate" : "final";
-  if (gate) {
+  r.frame = gate ? "gate" : settings.frame == "passed" ? "passed" : "final";
+  if (r.frame == "passed") {
+    r.window_min_x_m = settings.window_min_x_m.value_or(snapshot.step_top_x_m + margin);
+    r.window_max_x_m = settings.window_max_x_m.value_or(snapshot.upstream_ice_front_x_m - margin);
+  } else if (gate) {
     r.window_min_x_m =
         settings.window_min_x_m.value_or(snapshot.gate_x_m - snapshot.gate_passed_length_m + margin);
     r.window_max_x_m = settings.window_max_x_m.value_or(snapshot.gate_x_m - margin);
@@ -405,8 +416,9 @@ CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
   // Closer than the floor: one feature. It keeps the deeper one's position and depth, the
   // union of their widths; the spacing between them is dropped and counted.
   std::vector<Candidate> kept;
+  const bool merge = r.spacing_rule == "merge";
   for (const Candidate& c : candidates) {
-    if (!kept.empty() && c.crevasse.x_m - kept.back().crevasse.x_m < r.resolution_floor_m) {
+    if (merge && !kept.empty() && c.crevasse.x_m - kept.back().crevasse.x_m < r.resolution_floor_m) {
       Candidate& k = kept.back();
       const std::size_t particles = k.crevasse.particle_count + c.crevasse.particle_count;
       const std::size_t merged = k.crevasse.merged_count + c.crevasse.merged_count;
@@ -432,8 +444,12 @@ CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
   for (std::size_t i = 0; i < kept.size(); ++i) {
     if (i + 1 < kept.size()) {
       const double s = kept[i + 1].crevasse.x_m - kept[i].crevasse.x_m;
-      kept[i].crevasse.spacing_to_next_m = s;
-      m.spacings_m.push_back(s);
+      if (s < r.resolution_floor_m) {  // "drop" only: merging left no spacing below the floor
+        ++m.dropped_spacing_count;
+      } else {
+        kept[i].crevasse.spacing_to_next_m = s;
+        m.spacings_m.push_back(s);
+      }
     }
     m.crevasses.push_back(kept[i].crevasse);
   }

@@ -26,6 +26,10 @@ struct MeasureSettings {
   //            its initial position — the fracture pattern the ice took over the step, before
   //            falling blocks shatter on the floor. Needs a snapshot with gate records.
   //   "final": the particles where they are at the snapshot's time.
+  //   "passed": the particles where they are at the snapshot's time, in the ice that came over
+  //            the step during the run: window [step_top_x + margin·H_i, front of the ice that
+  //            started upstream of the top of the step − margin·H_i]. Where the field forms
+  //            when the ice goes on cracking past the lip (docs/measurement.md).
   //   "auto":  "gate" when the snapshot has gate records, else "final".
   std::string frame = "auto";
 
@@ -41,6 +45,11 @@ struct MeasureSettings {
   // Neighbouring crevasses closer than this are one feature at this resolution: merged, and
   // the spacing between them is dropped and counted (docs/measurement.md).
   double resolution_floor_over_dx = 3.0;
+  // What the floor does to two crevasses closer than it:
+  //   "merge": one feature, as above (the deeper one's position and depth);
+  //   "drop":  the source study's rule: both are kept, only the spacing between them is dropped
+  //            and counted.
+  std::string spacing_rule = "merge";
   // A crevasse shallower than this is not resolved either (a damaged lens one or two particle
   // rows under the surface cannot be told from an opening at this resolution): not counted,
   // and counted in shallow_count instead. 0 counts every surface-reaching cluster.
@@ -73,7 +82,7 @@ struct MeasureSettings {
 
 // The numbers actually used, recorded with every result.
 struct ResolvedMeasureSettings {
-  std::string frame = "final";  // "gate" or "final"
+  std::string frame = "final";  // "gate", "final" or "passed"
   double damage_threshold = 0.0;
   double eps_v_p_threshold = 0.0;         // the ε_v^p at which a particle becomes damaged
   bool threshold_from_softening = false;  // false: the absolute ε_v^p threshold was used
@@ -84,6 +93,7 @@ struct ResolvedMeasureSettings {
   double ice_thickness_m = 0.0;
   double particle_spacing_m = 0.0;
   double resolution_floor_m = 0.0;
+  std::string spacing_rule = "merge";
   double min_depth_m = 0.0;
   double link_distance_m = 0.0;
   double surface_reach_m = 0.0;

@@ -63,6 +63,7 @@ nlohmann::json settings_to_json(const ResolvedMeasureSettings& s) {
       {"ice_thickness_m", s.ice_thickness_m},
       {"particle_spacing_m", s.particle_spacing_m},
       {"resolution_floor_m", s.resolution_floor_m},
+      {"spacing_rule", s.spacing_rule},
       {"min_depth_m", s.min_depth_m},
       {"link_distance_m", s.link_distance_m},
       {"surface_reach_m", s.surface_reach_m},

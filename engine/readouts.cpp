@@ -108,6 +108,11 @@ ParticleSnapshot make_snapshot(const Particles<Dim>& P, const SceneConfig& scene
   s.step_top_x_m = scene.step_top_x();
   s.step_foot_x_m = scene.step_foot_x();
   s.ice_front_x_m = ice_front_x(P, scene, 0.25);
+  if (!P.x_ref.empty()) {
+    const double top = scene.step_top_x();
+    for (std::size_t p = 0; p < P.size(); ++p)
+      if (P.x_ref[p][0] < top) s.upstream_ice_front_x_m = std::max(s.upstream_ice_front_x_m, P.x[p][0]);
+  }
   s.particle_spacing_m = scene.dx / scene.particles_per_cell_axis;
   if (bed) s.bed_profile = bed->vertices();
   const std::size_t n = P.size();

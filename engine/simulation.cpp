@@ -102,6 +102,13 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
       hold_nodes_at_speed(grid_, -kInfinity, kInflowHoldCells * scene_.dx, drive_speed_now(), false);
     });
   }
+  // The boundary stages between these two brackets are the only ones that can act on the
+  // downstream band (bed friction and gravity come before); their change of its momentum is the
+  // impulse the domain's end gives the ice. The band is a contiguous tail of the nodes (x is
+  // the slowest axis), a few columns: negligible next to the step.
+  const bool glacier = scene_.body == Body::slab;
+  if (glacier)
+    add_stage("downstream_band_before", [this] { downstream_before_z_ = downstream_band_momentum_z(); });
   if (scene_.has(Effect::downstream_drive)) {
     // The glacier goes on past the domain: the nodes of the last cells before the outflow line
     // move with it, at (V(t), 0) on the flat floor. Without this the floor ice is free to be
@@ -119,6 +126,10 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   }
   if (scene_.has(Effect::velocity_boundaries))
     add_stage("velocity_boundaries", [this] { apply_velocity_boxes(grid_, scene_.velocity_boxes, time_); });
+  if (glacier)
+    add_stage("downstream_band_after", [this] {
+      if (!settling_) downstream_impulse_z_ += downstream_band_momentum_z() - downstream_before_z_;
+    });
   if (scene_.settle_time > 0.0) {
     // Damping exists only while settling: one branch per step, none per particle.
     settle_damping_rate_ = scene_.p_wave_speed() /
@@ -610,6 +621,18 @@ void Simulation<Dim>::finish_step() {
   time_ += dt_;
   ++steps_;
   summary_step_ = steps_;
+}
+
+template <int Dim>
+double Simulation<Dim>::downstream_band_momentum_z() const {
+  const double x0 = domain_hi_[0] - (kDownstreamDriveCells + 1.0) * scene_.dx;
+  const long first_column = static_cast<long>(std::ceil(x0 / grid_.dx)) - grid_.lo[0];
+  if (first_column >= grid_.n[0]) return 0.0;
+  double pz = 0.0;
+  for (std::size_t f = static_cast<std::size_t>(std::max(0L, first_column)) * grid_.stride[0];
+       f < grid_.nodes.size(); ++f)
+    pz += grid_.nodes[f].mass * grid_.nodes[f].vel[up_axis<Dim>];
+  return pz;
 }
 
 template <int Dim>

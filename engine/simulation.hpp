@@ -78,6 +78,11 @@ class Simulation {
   double max_speed() const { return max_speed_; }
   const Bed* bed() const { return bed_.has_value() ? &*bed_ : nullptr; }
   double max_yield_violation() const { return crevasse::max_yield_violation(particles_, plastic_); }
+  // Vertical impulse [N·s per unit width in 2D] that whatever ends the domain downstream (held
+  // nodes, walls, velocity boxes) has given the ice since the settling phase: the change of
+  // vertical grid momentum those boundary stages make in the last cells before the domain's
+  // end. Nothing downstream may carry the glacier (docs/model.md). Not checkpointed.
+  double downstream_impulse_z() const { return downstream_impulse_z_; }
 
   ParticleSnapshot snapshot() const {
     return make_snapshot(particles_, scene_, plastic_, time_, bed(), records_gate() ? &gate_ : nullptr);
@@ -138,6 +143,8 @@ class Simulation {
   // downstream_drive holds the nodes of this many cells upstream of the domain's end (the
   // outflow line is 3 cells from it, so 2 cells of ice before it move at the drive speed).
   static constexpr double kDownstreamDriveCells = 5.0;
+  // Vertical grid momentum in the downstream band (the held cells and one more).
+  double downstream_band_momentum_z() const;
   void gather_velocity(std::size_t p, const StencilWeights<Dim>& w, const StencilOffsets<Dim>& d,
                        std::size_t f0, double c_scale);
   // ΔJ-bar volume averaging fused into the G2P sweeps (simulation.cpp explains it): gather v, C
@@ -238,6 +245,8 @@ class Simulation {
   std::int64_t particle_steps_ = 0;
   std::int64_t return_map_evaluations_ = 0;
   double removed_mass_ = 0.0;
+  double downstream_before_z_ = 0.0;
+  double downstream_impulse_z_ = 0.0;
   double inflow_mass_ = 0.0;
   std::int64_t inflow_columns_ = 0;  // columns seeded by the inflow so far
   // Largest physically possible particle speed [m/s] (slab scenes with gravity; 0 = none):

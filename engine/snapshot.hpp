@@ -45,6 +45,9 @@ struct ParticleSnapshot {
   // Front of the connected ice (Simulation::ice_front_x) when the engine filled it in (> 0);
   // scattered debris ahead of the ice does not move it.
   double ice_front_x_m = 0.0;
+  // Most downstream x of the ice that started upstream of the top of the step, i.e. that came
+  // over the step during the run (0 when the scene keeps no initial positions: no gate).
+  double upstream_ice_front_x_m = 0.0;
   // The ice front [m]: ice_front_x_m when set, else the x of the most downstream particle.
   double front_x() const;
 };

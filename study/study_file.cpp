@@ -53,6 +53,8 @@ std::optional<Range> named_range(const std::string& name) {
       {"thickness", {0.0, 1e5, true, false}},
       {"cohesion_ratio", {0.0, 1e4, true, false}},
       {"shear_strength_ratio", {0.0, 1e4, true, false}},
+      {"shear_to_tensile_ratio", {0.0, 1e4, true, false}},
+      {"draped_length_ratio", {0.0, 1e3, false, false}},
       {"gate_offset_ratio", {0.0, 1e3, false, false}},
       {"step_length_ratio", {0.0, 1e3, false, false}},
       {"slope", {0.0, 1e3, true, false}},
@@ -75,6 +77,8 @@ const std::map<std::string, std::string>& named_targets() {
       {"thickness", "/ice/thickness"},
       {"cohesion_ratio", "/ice/tensile_strength"},
       {"shear_strength_ratio", "/ice/shear_strength"},
+      {"shear_to_tensile_ratio", "/ice/shear_strength"},
+      {"draped_length_ratio", "/ice/draped_length"},
       {"gate_offset_ratio", "/run/gate_offset"},
       {"step_length_ratio", "/bed/step_length"},
       {"slope", "/bed/step_height"},
@@ -252,7 +256,7 @@ analysis::MeasureSettings measure_settings_from_json(const json& j) {
   const ordered_json o = j;
   refuse_unknown_keys(o, "measurement",
                  {"frame", "damage_threshold", "eps_v_p_threshold", "window_min_x_m", "window_max_x_m",
-                  "window_margin_over_h", "resolution_floor_over_dx", "min_depth_over_dx", "link_distance_over_spacing",
+                  "window_margin_over_h", "resolution_floor_over_dx", "spacing_rule", "min_depth_over_dx", "link_distance_over_spacing",
                   "surface_reach_over_dx", "surface_smoothing_bins",
                   "surface_bridge_half_width_over_h", "fragmented_fraction", "y_band_width_over_dx",
                   "y_band_center_m", "dx_m", "ice_thickness_m", "particle_spacing_m"});
@@ -265,8 +269,9 @@ analysis::MeasureSettings measure_settings_from_json(const json& j) {
   };
   if (o.contains("frame")) {
     const auto& f = o.at("frame");
-    if (!f.is_string() || (f != "auto" && f != "gate" && f != "final"))
-      fail("measurement.frame", "value " + f.dump() + " is not \"auto\", \"gate\" or \"final\"");
+    if (!f.is_string() || (f != "auto" && f != "gate" && f != "final" && f != "passed"))
+      fail("measurement.frame",
+           "value " + f.dump() + " is not \"auto\", \"gate\", \"final\" or \"passed\"");
     s.frame = f.get<std::string>();
   }
   num("damage_threshold", s.damage_threshold, {0.0, 1.0, true, true});
@@ -278,6 +283,12 @@ analysis::MeasureSettings measure_settings_from_json(const json& j) {
                                            " must exceed window_min_x_m " + fmt(*s.window_min_x_m));
   num("window_margin_over_h", s.window_margin_over_h, {0.0, 100.0, false, false});
   num("resolution_floor_over_dx", s.resolution_floor_over_dx, {0.0, 100.0, false, false});
+  if (o.contains("spacing_rule")) {
+    const auto& f = o.at("spacing_rule");
+    if (!f.is_string() || (f != "merge" && f != "drop"))
+      fail("measurement.spacing_rule", "value " + f.dump() + " is not \"merge\" or \"drop\"");
+    s.spacing_rule = f.get<std::string>();
+  }
   num("min_depth_over_dx", s.min_depth_over_dx, {0.0, 100.0, false, false});
   num("link_distance_over_spacing", s.link_distance_over_spacing, {0.0, 10.0, true, false});
   num("surface_reach_over_dx", s.surface_reach_over_dx, {0.0, 100.0, true, false});
@@ -301,7 +312,7 @@ analysis::MeasureSettings measure_settings_from_json(const json& j) {
 
 json measure_settings_to_json(const analysis::MeasureSettings& s) {
   auto opt = [](const std::optional<double>& v) { return v ? json(*v) : json(nullptr); };
-  return {
+  json j = {
       {"frame", s.frame},
       {"damage_threshold", s.damage_threshold},
       {"eps_v_p_threshold", s.eps_v_p_threshold},
@@ -321,6 +332,9 @@ json measure_settings_to_json(const analysis::MeasureSettings& s) {
       {"ice_thickness_m", opt(s.ice_thickness_m)},
       {"particle_spacing_m", opt(s.particle_spacing_m)},
   };
+  // Written only when not the default, so that the case hashes of every stored study stay.
+  if (s.spacing_rule != "merge") j["spacing_rule"] = s.spacing_rule;
+  return j;
 }
 
 namespace {
@@ -391,6 +405,9 @@ void parse_parameters(const ordered_json& doc, Study& st) {
       fail(name, "and " + target + " both set the same scene field; give only one of them");
   if (seen.count("slope") && seen.count("step_height_ratio"))
     fail("slope", "and step_height_ratio both set the step height; give only one of them");
+  if (seen.count("shear_strength_ratio") && seen.count("shear_to_tensile_ratio"))
+    fail("shear_to_tensile_ratio",
+         "and shear_strength_ratio both set the shear strength; give only one of them");
 
   if (doc.contains("replicas")) {
     const ordered_json& r = doc.at("replicas");
@@ -452,6 +469,13 @@ void apply_named_parameters(json& scene, std::map<std::string, double>& named, c
       fail(where, std::string(name) + " needs gravity.g > 0 (it is relative to ρ_i g H_i), got g = " + fmt(g));
     scene["ice"][field] = stress_from_overburden_ratio(named[name], rho, g, h_i);
   }
+  // q_y = k·c: a material constant k keeps Π the only strength group (docs/model.md), where a
+  // q_y relative to ρ_i g H_i would add a second one.
+  if (has("shear_to_tensile_ratio"))
+    scene["ice"]["shear_strength"] =
+        named["shear_to_tensile_ratio"] *
+        number_at(scene, "/ice/tensile_strength", defaults.tensile_strength);
+  if (has("draped_length_ratio")) scene["ice"]["draped_length"] = named["draped_length_ratio"] * h_i;
   if (has("step_length_ratio")) scene["bed"]["step_length"] = named["step_length_ratio"] * h_i;
   if (has("slope")) {
     const double l_s = number_at(scene, "/bed/step_length", defaults.step_length);

@@ -23,6 +23,8 @@ inline constexpr const char* kStudyParameterNames[] = {
     "thickness",               // H_i [m]
     "cohesion_ratio",          // Π = c / (ρ_i g H_i)
     "shear_strength_ratio",    // q_y / (ρ_i g H_i)
+    "shear_to_tensile_ratio",  // k = q_y / c, a material constant
+    "draped_length_ratio",     // ice past the lip at the start (over the ramp and floor) / H_i
     "gate_offset_ratio",       // gate past the top of the step / H_i
     "step_length_ratio",       // r = L_s / H_i (0 = vertical step)
     "slope",                   // S = H_s / L_s

@@ -163,13 +163,18 @@ TEST(MeasureDepthFloor, FeaturesShallowerThanThreeCellsAreNotCrevasses) {
   EXPECT_EQ(every.spacings_m.size(), 2u);
 }
 
+// Four notches of which two stand 20 m apart, closer than the floor 3·dx = 30 m.
+std::vector<Notch> close_pair_notches() {
+  return {{.x_m = 300.0, .depth_m = 30.0},
+          {.x_m = 400.0, .depth_m = 30.0},
+          {.x_m = 420.0, .depth_m = 50.0},
+          {.x_m = 520.0, .depth_m = 30.0}};
+}
+
 TEST(MeasureFloor, NotchesCloserThanTheFloorCountAsOne) {
   SlabSpec spec;
   // 20 m < 3·dx = 30 m apart: one feature at this resolution, keeping the deeper one.
-  const std::vector<Notch> notches = {{.x_m = 300.0, .depth_m = 30.0},
-                                      {.x_m = 400.0, .depth_m = 30.0},
-                                      {.x_m = 420.0, .depth_m = 50.0},
-                                      {.x_m = 520.0, .depth_m = 30.0}};
+  const std::vector<Notch> notches = close_pair_notches();
   const CrevasseMeasurement m = measure_crevasses(make_slab(spec, notches));
   ASSERT_EQ(m.crevasses.size(), 3u);
   EXPECT_EQ(m.dropped_spacing_count, 1u);
@@ -181,6 +186,56 @@ TEST(MeasureFloor, NotchesCloserThanTheFloorCountAsOne) {
   // The merged width spans both notches: 20 m apart plus one column.
   EXPECT_NEAR(m.crevasses[1].width_m, 25.0, spec.dx_m);
   for (double s : m.spacings_m) EXPECT_GE(s, m.settings.resolution_floor_m);
+}
+
+// The source study's rule on the same field: nothing merged; both notches 20 m apart stay, with
+// their own depths, and only the 20 m spacing between them is dropped and counted. The
+// spacings are then 100, 100 m (300→400, 420→520) instead of 120, 100 m.
+TEST(MeasureFloor, SourceRuleKeepsBothAndDropsOnlyTheSpacing) {
+  SlabSpec spec;
+  const std::vector<Notch> notches = close_pair_notches();
+  MeasureSettings source;
+  source.spacing_rule = "drop";
+  const CrevasseMeasurement m = measure_crevasses(make_slab(spec, notches), source);
+  ASSERT_EQ(m.crevasses.size(), 4u);
+  EXPECT_EQ(m.dropped_spacing_count, 1u);
+  ASSERT_EQ(m.spacings_m.size(), 2u);
+  for (const Crevasse& c : m.crevasses) EXPECT_EQ(c.merged_count, 1u);
+  EXPECT_NEAR(m.crevasses[1].depth_m, 30.0, spec.dx_m);
+  EXPECT_NEAR(m.crevasses[2].depth_m, 50.0, spec.dx_m);
+  EXPECT_FALSE(m.crevasses[1].spacing_to_next_m.has_value());
+  EXPECT_NEAR(m.spacings_m[0], 100.0, spec.dx_m);
+  EXPECT_NEAR(m.spacings_m[1], 100.0, spec.dx_m);
+  EXPECT_EQ(m.settings.spacing_rule, "drop");
+  // The median depth sees four crevasses: 30, 30, 30, 50 m.
+  ASSERT_TRUE(m.depth_m.has_value());
+  EXPECT_NEAR(m.depth_m->median, 30.0, spec.dx_m);
+  MeasureSettings bad;
+  bad.spacing_rule = "keep";
+  EXPECT_THROW(measure_crevasses(make_slab(spec, notches), bad), std::invalid_argument);
+}
+
+// The "passed" frame measures the ice that came over the step during the run: from half an H_i
+// past the top of the step to half an H_i behind the front of the ice that started upstream of
+// it. A notch in the ice that lay past the step from the start is left out.
+TEST(MeasureWindow, PassedFrameEndsAtTheIceThatCameOverTheStep) {
+  SlabSpec spec;
+  const std::vector<Notch> notches = {{.x_m = 300.0, .depth_m = 30.0},
+                                      {.x_m = 600.0, .depth_m = 30.0},
+                                      {.x_m = 1200.0, .depth_m = 30.0}};
+  ParticleSnapshot s = make_slab(spec, notches);
+  s.step_top_x_m = 100.0;
+  s.upstream_ice_front_x_m = 900.0;
+  MeasureSettings passed;
+  passed.frame = "passed";
+  const CrevasseMeasurement m = measure_crevasses(s, passed);
+  EXPECT_EQ(m.settings.frame, "passed");
+  EXPECT_DOUBLE_EQ(m.settings.window_min_x_m, 150.0);
+  EXPECT_DOUBLE_EQ(m.settings.window_max_x_m, 850.0);
+  ASSERT_EQ(m.crevasses.size(), 2u);
+  EXPECT_NEAR(m.crevasses[1].x_m, 600.0, spec.dx_m);
+  s.upstream_ice_front_x_m = 0.0;  // no record of where the ice came from
+  EXPECT_THROW(measure_crevasses(s, passed), std::invalid_argument);
 }
 
 // Damage every particle of `s` inside the box [x0, x1] × [z0, z1] (to the notches' ε_v^p).

@@ -186,6 +186,40 @@ TEST(ReturnMapping, PlasticOpeningNeverDecreasesSnapBack3d) { check_strain_paths
 // The implicit increment solves g(Δ) = p_tr + KΔ + c·exp(−ζ(ε_v^p + Δ)) = 0 inside the bracket
 // [0, −p_tr/K], including near ζ → K/c where g' → 0 at Δ = 0, and past it (cζ/K = 2, 10, 100:
 // g first decreases, but it is convex and negative at 0, so it crosses zero once).
+// Opened ice (strength gone: ε_v^p = 20/ζ, e^{−20} of it left) keeps no tension, neither
+// through its mean stress (the cap) nor through its deviator: for any trial strain the largest
+// principal Kirchhoff stress after the return is at most e^{−20}(c + q_y) — nil. With the literal
+// law (q_y kept by damaged ice) the same trials carry tensions of the order of q_y, which is
+// what blew up a free glacier; the test checks that too, so it would fail if softening the shear
+// strength stopped reaching the return. Residual friction only acts under compression (M·p with
+// p > 0), where σ_1 = −p + q/√3 stays compressive for M < √3, so it keeps the property.
+template <int Dim>
+void check_opened_ice_keeps_no_tension() {
+  const double c = 3.6e5, zeta = 500.0, qy = 3.6e6;
+  const double opened = 20.0 / zeta;
+  std::mt19937 rng(4242);
+  std::uniform_real_distribution<double> strain(-2e-3, 2e-3);
+  for (double m_residual : {0.0, 1.2}) {
+    CappedVonMisesParams soft = params(c, zeta, qy);
+    soft.residual_friction_m = m_residual;
+    CappedVonMisesParams literal = soft;
+    literal.damage_softens_shear = false;
+    double literal_max = 0.0;
+    for (int trial = 0; trial < 2000; ++trial) {
+      Vec<Dim> eps;
+      for (int a = 0; a < Dim; ++a) eps[a] = strain(rng);
+      const auto r = return_map_capped_von_mises<Dim>(eps, opened, kModuli, soft);
+      const double tension = principal_kirchhoff<Dim>(kModuli, r.eps).maxCoeff();
+      ASSERT_LE(tension, 1e-6 * c) << "trial " << trial << " M = " << m_residual;
+      const auto l = return_map_capped_von_mises<Dim>(eps, opened, kModuli, literal);
+      literal_max = std::max(literal_max, principal_kirchhoff<Dim>(kModuli, l.eps).maxCoeff());
+    }
+    EXPECT_GT(literal_max, 0.5 * qy / std::sqrt(3.0)) << "M = " << m_residual;
+  }
+}
+TEST(ReturnMapping, OpenedIceKeepsNoTensionThroughItsDeviator2d) { check_opened_ice_keeps_no_tension<2>(); }
+TEST(ReturnMapping, OpenedIceKeepsNoTensionThroughItsDeviator3d) { check_opened_ice_keeps_no_tension<3>(); }
+
 TEST(ReturnMapping, ImplicitCapIncrementSolvesTheConsistencyEquation) {
   const double k = kModuli.bulk(2);
   for (const double frac : {0.01, 0.3, 0.9, 0.999, 2.0, 10.0, 100.0}) {
