@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Compare replicated settings of a numerical lever with a reference setting.
 
-    python3 scripts/lever_table.py results/flowing_domain_replicas_total_volume.db \
+    python3 scripts/lever_table.py results/numerics/flowing_domain_replicas_total_volume.db \
         [MORE.db ...] --reference upstream_length_ratio=2 downstream_length_ratio=3.95
 
 A study that sweeps one or more numerical settings (domain lengths, drive speed, CFL) crossed with

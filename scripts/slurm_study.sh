@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs a study as a SLURM job array, one shard per array task, then merges the shards.
 #
-#   scripts/slurm_study.sh studies/flowing_domain.json 9                  # 9 shards
+#   scripts/slurm_study.sh studies/numerics/flowing_domain.json 9         # 9 shards
 #   SLURM_CPUS=4 SLURM_TIME=2-00:00:00 scripts/slurm_study.sh STUDY N [extra sbatch options]
 #
 # Each task runs `crevasse study STUDY --shard I/N --db results/<name>.shard-I-of-N.db` with as

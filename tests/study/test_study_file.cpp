@@ -370,15 +370,16 @@ TEST(Shard, ParsesAndRefuses) {
 namespace crevasse {
 namespace {
 
-// Every study shipped in studies/ loads (named after its file) and runs a glacier in contact with
-// its bed across the whole step (draped to the outflow, no ice cliff); the calving-front studies
-// of studies/cliff/ all start from the cliff. quick.json runs the flowing glacier (fed by an
+// Every study shipped in studies/ and studies/numerics/ loads (named after its file) and runs a
+// glacier in contact with its bed across the whole step (draped to the outflow, no ice cliff); the
+// calving-front studies of studies/cliff/ all start from the cliff. quick.json runs the flowing glacier (fed by an
 // inflow) from weak to strong ice in 2D, with its strongest cases resolved (c/(ρ_i g) ≥ 3 dx).
 TEST(ShippedStudies, AllLoadAndQuickSpansWeakToStrongIce) {
   const std::filesystem::path dir = std::filesystem::path(CREVASSE_SOURCE_DIR) / "studies";
   int loaded = 0;
-  for (const bool cliff : {false, true}) {
-    for (const auto& entry : std::filesystem::directory_iterator(cliff ? dir / "cliff" : dir)) {
+  for (const std::string sub : {"", "numerics", "cliff"}) {
+    const bool cliff = sub == "cliff";
+    for (const auto& entry : std::filesystem::directory_iterator(dir / sub)) {
       if (entry.path().extension() != ".json") continue;
       SCOPED_TRACE(entry.path().string());
       const Study s = load_study_file(entry.path());
