@@ -72,6 +72,21 @@ CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx) {
                    r.wall_s > 0 ? static_cast<double>(r.particle_steps) / r.wall_s : 0.0}};
   try {
     out.measurement = analysis::measure_crevasses(r.final_snapshot, ctx.measurement());
+    // The other spacing rule on the same snapshot, so that both are reported
+    // (docs/measurement.md, "The source study's rule"): result_json.other_spacing_rule.
+    analysis::MeasureSettings other = ctx.measurement();
+    other.spacing_rule = other.spacing_rule == "merge" ? "drop" : "merge";
+    const analysis::CrevasseMeasurement alt = analysis::measure_crevasses(r.final_snapshot, other);
+    nlohmann::json depths = nlohmann::json::array();
+    for (const auto& c : alt.crevasses) depths.push_back(c.depth_m);
+    out.result_extra["other_spacing_rule"] = {
+        {"spacing_rule", other.spacing_rule},
+        {"crevasse_count", alt.crevasses.size()},
+        {"spacings_m", alt.spacings_m},
+        {"depths_m", depths},
+        {"dropped_spacing_count", alt.dropped_spacing_count},
+        {"spacing_median_m", alt.spacing_m ? nlohmann::json(alt.spacing_m->median) : nlohmann::json()},
+        {"depth_median_m", alt.depth_m ? nlohmann::json(alt.depth_m->median) : nlohmann::json()}};
   } catch (const std::invalid_argument& e) {
     throw SimulationError(std::string("measurement of the final snapshot failed: ") + e.what());
   }

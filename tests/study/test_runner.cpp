@@ -237,6 +237,12 @@ TEST(Runner, RealTinySimulationsAreStoredWithTheirMeasurements) {
                       "FROM cases c JOIN summaries s USING (case_id) ORDER BY case_index");
   ASSERT_EQ(rows.size(), 3u);
   for (const auto& row : rows) EXPECT_EQ(row, "done|max_steps|300|1|1|1|1");
+  // Each case is measured under the other spacing rule too (the source study's "drop").
+  const auto other = test::dump_rows(
+      dir / "s.db",
+      "SELECT json_extract(result_json, '$.extra.other_spacing_rule.spacing_rule'), "
+      "json_type(result_json, '$.extra.other_spacing_rule.crevasse_count') FROM cases ORDER BY case_index");
+  for (const auto& row : other) EXPECT_EQ(row, "drop|integer");
   // Deterministic with one engine thread per case: a second database holds the same results.
   RunnerOptions o2 = o;
   o2.db_path = dir / "t.db";

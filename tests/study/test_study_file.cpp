@@ -372,8 +372,9 @@ namespace {
 
 // Every study shipped in studies/ and studies/numerics/ loads (named after its file) and runs a
 // glacier in contact with its bed across the whole step (draped to the outflow, no ice cliff); the
-// calving-front studies of studies/cliff/ all start from the cliff. quick.json runs the flowing glacier (fed by an
-// inflow) from weak to strong ice in 2D, with its strongest cases resolved (c/(ρ_i g) ≥ 3 dx).
+// calving-front studies of studies/cliff/ all start from the cliff. quick.json runs the pushed glacier (fed by an
+// inflow, free downstream, q_y = 10 c) from weak to strong ice in 2D, with its strongest cases resolved
+// (c/(ρ_i g) ≥ 3 dx).
 TEST(ShippedStudies, AllLoadAndQuickSpansWeakToStrongIce) {
   const std::filesystem::path dir = std::filesystem::path(CREVASSE_SOURCE_DIR) / "studies";
   int loaded = 0;
@@ -405,6 +406,10 @@ TEST(ShippedStudies, AllLoadAndQuickSpansWeakToStrongIce) {
     EXPECT_EQ(c.scene.drive_boundary, DriveBoundary::inflow);
     EXPECT_GT(c.scene.draped_length, c.scene.upstream_length + c.scene.step_length);
     EXPECT_LE(c.scene.ice_thickness, 200.0);
+    // The pushed scene: nothing held downstream, not carried by a tilted gravity, q_y = k c.
+    EXPECT_FALSE(c.scene.has(Effect::downstream_drive));
+    EXPECT_EQ(c.scene.gravity_tilt_deg, 0.0);
+    EXPECT_NEAR(c.scene.shear_strength, 10.0 * c.scene.tensile_strength, 1e-6 * c.scene.shear_strength);
     lo = std::min(lo, c.groups.cohesion_ratio);
     hi = std::max(hi, c.groups.cohesion_ratio);
     const SceneConfig& sc = c.scene;
@@ -458,6 +463,33 @@ TEST(StudyFile, ShearStrengthRatioAndGateOffsetRatioScaleWithThickness) {
   EXPECT_DOUBLE_EQ(c.shear_strength, 1.5 * c.density * c.gravity * 40.0);
   EXPECT_DOUBLE_EQ(c.gate_offset, 10.0);
   EXPECT_DOUBLE_EQ(c.gate_x(), c.step_top_x() + 10.0);
+}
+
+// q_y = k c follows the tensile strength however it is given (Π or the pointer), not H_i; the
+// draped length is in H_i; giving q_y both ways is refused naming both.
+TEST(StudyFile, ShearToTensileRatioFollowsTheTensileStrength) {
+  nlohmann::json j = {{"name", "t"}, {"base_scene", test::tiny_scene()}};
+  j["fixed"] = {{"shear_to_tensile_ratio", 10.0}, {"draped_length_ratio", 0.5}};
+  j["sweep"] = {{"thickness", {40.0, 80.0}}, {"/ice/tensile_strength", {1.0e5, 2.0e5}}};
+  const Study s = test::parse(j);
+  ASSERT_EQ(s.cases.size(), 4u);
+  for (const auto& sc : s.cases) {
+    EXPECT_DOUBLE_EQ(sc.scene.shear_strength, 10.0 * sc.scene.tensile_strength) << sc.label;
+    EXPECT_DOUBLE_EQ(sc.scene.draped_length, 0.5 * sc.scene.ice_thickness) << sc.label;
+  }
+  j["sweep"] = {{"cohesion_ratio", {0.1}}};
+  j["fixed"]["thickness"] = 40.0;
+  const Study pi = test::parse(j);
+  const SceneConfig& c = pi.cases[0].scene;
+  EXPECT_DOUBLE_EQ(c.shear_strength, 10.0 * 0.1 * c.density * c.gravity * 40.0);
+  j["fixed"]["shear_strength_ratio"] = 1.0;
+  try {
+    test::parse(j);
+    FAIL() << "both shear strengths accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("shear_to_tensile_ratio"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("shear_strength_ratio"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
