@@ -94,6 +94,11 @@ class ConsoleObserver : public StudyObserver {
     if (!printer_is_tty_throttled(p)) printer_.update(line);
   }
 
+  void warn(const std::string& message) {
+    printer_.finish();
+    std::fprintf(stderr, "crevasse: warning: %s\n", message.c_str());
+  }
+
   void on_end(const RunnerReport& r) override {
     printer_.finish();
     std::fprintf(
@@ -167,6 +172,8 @@ int study_command(const StudyCommandOptions& opt) {
   ro.command = opt.command_line;
   ro.views_dir = opt.views_dir;
   ro.observer = opt.quiet ? nullptr : &console;
+  // Shown even with --quiet: a warning says that work may have to be redone.
+  ro.warn = [&console](const std::string& m) { console.warn(m); };
   const InterruptHandlers handlers;
   ro.interrupt = &g_interrupt;
   const RunnerReport r = run_study(study, ro);

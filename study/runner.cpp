@@ -23,6 +23,9 @@ namespace {
 
 using clock_type = std::chrono::steady_clock;
 
+// Next to the database, so that a resumed session finds it.
+std::filesystem::path checkpoint_dir(const std::filesystem::path& db) { return db.string() + ".checkpoints"; }
+
 double seconds_since(clock_type::time_point t0) {
   return std::chrono::duration<double>(clock_type::now() - t0).count();
 }
@@ -65,10 +68,11 @@ nlohmann::json deterministic_result(const CaseOutcome& o) {
 
 // What a worker hands to the writer (the calling thread).
 struct Event {
-  enum class Kind { started, finished, cancelled } kind;
+  enum class Kind { started, finished, cancelled, warning } kind;
   std::size_t slot = 0;  // index into the list of cases to run
   CaseResult result;     // finished only
   std::string started_at;
+  std::string message;  // warning only
 };
 
 class EventQueue {
@@ -224,6 +228,15 @@ class StudyRun {
     case_function_ = opt_.case_function ? opt_.case_function : CaseFunction(run_engine_case);
 
     store_.init_study(study_);
+    if (study_.resources.checkpoint_interval_s > 0) {
+      const std::filesystem::path dir = checkpoint_dir(opt_.db_path);
+      std::error_code ec;
+      std::filesystem::create_directories(dir, ec);
+      if (ec || !std::filesystem::is_directory(dir))
+        throw InputError("resources.checkpoint_interval_s: cannot create the checkpoint folder " +
+                         dir.string() + (ec ? " (" + ec.message() + ")" : "") +
+                         "; remove what is in its place, or set checkpoint_interval_s to 0");
+    }
     const std::vector<const StudyCase*> scope =
         opt_.shard ? shard_cases(study_, *opt_.shard) : shard_cases(study_, Shard{0, 1});
     report_.in_scope = scope.size();
@@ -272,16 +285,12 @@ class StudyRun {
     if (exact_peak_rss_) reset_peak_rss();
     CaseContext ctx(threads, time_limit_, study_.measurement, stop(), fraction_[slot]);
     if (!opt_.views_dir.empty()) ctx.set_views_dir(opt_.views_dir);
+    ctx.set_warn([this, slot](const std::string& m) { queue_.push(Event{Event::Kind::warning, slot, {}, {}, m}); });
     std::filesystem::path checkpoint;
     if (study_.resources.checkpoint_interval_s > 0) {
-      // Next to the database: DB.checkpoints/CASE.ckpt (kept only while the case is unfinished).
-      const std::filesystem::path dir = opt_.db_path.string() + ".checkpoints";
-      std::error_code ec;
-      std::filesystem::create_directories(dir, ec);
-      if (!ec) {
-        checkpoint = dir / (c.case_id + ".ckpt");
-        ctx.set_checkpoint(checkpoint, study_.resources.checkpoint_interval_s);
-      }
+      // DB.checkpoints/CASE.ckpt, kept only while the case is unfinished (set_up made the folder).
+      checkpoint = checkpoint_dir(opt_.db_path) / (c.case_id + ".ckpt");
+      ctx.set_checkpoint(checkpoint, study_.resources.checkpoint_interval_s);
     }
     CaseOutcome outcome;
     std::string failure;
@@ -361,6 +370,9 @@ class StudyRun {
               eta.started(e.slot);
               --progress_.pending;
               break;
+            case Event::Kind::warning:
+              if (opt_.warn) opt_.warn(c.label + ": " + e.message);
+              break;
             case Event::Kind::cancelled:
               store_.mark_pending(c.case_id);
               eta.stopped(e.slot);
@@ -426,6 +438,19 @@ class StudyRun {
 
 }  // namespace
 
-RunnerReport run_study(const Study& study, const RunnerOptions& opt) { return StudyRun(study, opt).run(); }
+RunnerReport run_study(const Study& study, const RunnerOptions& opt) {
+  // Before the database is opened: a file where the checkpoint folder belongs would otherwise
+  // turn checkpointing off without a word, or be found only after hours of simulation.
+  if (study.resources.checkpoint_interval_s > 0) {
+    const std::filesystem::path dir = checkpoint_dir(opt.db_path);
+    std::error_code ec;
+    const auto st = std::filesystem::status(dir, ec);
+    if (std::filesystem::exists(st) && !std::filesystem::is_directory(st))
+      throw InputError("resources.checkpoint_interval_s: " + dir.string() +
+                       " must be a folder for the checkpoints but is a file; remove or rename it, "
+                       "or set checkpoint_interval_s to 0");
+  }
+  return StudyRun(study, opt).run();
+}
 
 }  // namespace crevasse

@@ -1,0 +1,192 @@
+// docs/reliability.md, "Faults never cost a case": a checkpoint can only help (an unusable one
+// is reported, dropped and the case reruns from t = 0; a failed write warns and the case goes
+// on; a stop leaves the case pending), the settling phase honours signals, the case time limit
+// and checkpoints, and a file where the checkpoint folder belongs is refused before anything runs.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <iterator>
+#include <thread>
+
+#include "study_test_support.hpp"
+
+namespace crevasse {
+namespace {
+
+using namespace std::chrono_literals;
+namespace fs = std::filesystem;
+using test::read_file;
+using test::run_cli;
+
+std::string one_value(const fs::path& db, const std::string& sql) {
+  const auto rows = test::dump_rows(db, sql);
+  return rows.empty() ? std::string() : rows.front();
+}
+
+// Waits (up to 60 s) for a .ckpt file in `dir`; returns its path or "".
+fs::path wait_for_checkpoint(const fs::path& dir) {
+  const auto deadline = std::chrono::steady_clock::now() + 60s;
+  while (std::chrono::steady_clock::now() < deadline) {
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(dir, ec))
+      if (e.path().extension() == ".ckpt") return e.path();
+    std::this_thread::sleep_for(5ms);
+  }
+  return {};
+}
+
+struct Ended {
+  int status = 0;
+  double seconds = 0.0;  // from the signal to the exit
+};
+
+Ended signal_and_wait(pid_t pid, int sig) {
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_EQ(::kill(pid, sig), 0);
+  Ended e;
+  ::waitpid(pid, &e.status, 0);
+  e.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return e;
+}
+
+std::vector<std::string> study_args(const fs::path& dir, const std::string& db) {
+  return {"study", (dir / "s.json").string(), "--db", (dir / db).string(), "--jobs", "1",
+          "--threads-per-case", "1", "--quiet"};
+}
+
+// One case of the tiny glacier whose checkpoints (every 50 ms) appear early.
+nlohmann::json checkpointed_study(std::int64_t max_steps) {
+  nlohmann::json study = test::tiny_study(2, max_steps, "rel");
+  study["sweep"] = {{"cohesion_ratio", {0.3}}};
+  study["resources"] = {{"checkpoint_interval_s", 0.05}};
+  return study;
+}
+
+// Every kind of unusable checkpoint in a case's place (empty, garbage, one flipped byte of a
+// real one, a directory, a FIFO) is reported on one warning line, removed, and the case runs
+// from t = 0 to the uninterrupted result: exit 0, done, never failed, never blocked. A stop
+// (SIGTERM) with the case unfinished leaves it pending with its checkpoint.
+TEST(Reliability, UnusableCheckpointIsDroppedAndTheCaseRerunsFromZero) {
+  test::ScratchDir dir("rel_ckpt");
+  test::write_text(dir / "s.json", checkpointed_study(1500).dump(2));
+  ASSERT_EQ(run_cli(dir.path(), "study s.json --db ref.db --jobs 1 --quiet").code, 0);
+  const std::string case_id = one_value(dir / "ref.db", "SELECT case_id FROM cases");
+
+  // A real checkpoint, of a long case (another case: foreign to s.json's): the study stopped by
+  // SIGTERM once it has one.
+  test::write_text(dir / "long.json", checkpointed_study(10000000).dump(2));
+  std::vector<std::string> args = study_args(dir.path(), "k.db");
+  args[1] = (dir / "long.json").string();
+  const pid_t pid = test::spawn_crevasse(args, (dir / "k_err.txt").string());
+  ASSERT_GT(pid, 0);
+  const fs::path real = wait_for_checkpoint(dir / "k.db.checkpoints");
+  ASSERT_FALSE(real.empty());
+  const Ended e = signal_and_wait(pid, SIGTERM);
+  ASSERT_TRUE(WIFEXITED(e.status)) << "the case ended before it could be stopped; make it longer";
+  EXPECT_EQ(WEXITSTATUS(e.status), 143);
+  EXPECT_EQ(one_value(dir / "k.db", "SELECT status FROM cases"), "pending") << "a stop failed the case";
+  ASSERT_TRUE(fs::is_regular_file(real));
+  std::string bytes;
+  {
+    std::ifstream f(real, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(f), {});
+  }
+  ASSERT_GT(bytes.size(), 1000u);
+  const std::string foreign = bytes;
+  bytes[bytes.size() / 2] ^= 0x04;
+
+  const std::vector<std::pair<std::string, std::string>> kinds = {
+      {"empty", "truncated or empty"}, {"garbage", "not a crevasse checkpoint"},
+      {"flipped", "checksum"},         {"foreign", "written for another scene"},
+      {"directory", "not a regular file"}, {"fifo", "not a regular file"}};
+  for (const auto& [kind, reason] : kinds) {
+    const std::string db = kind + ".db";
+    const fs::path ckpt = dir / (db + ".checkpoints") / (case_id + ".ckpt");
+    fs::create_directories(ckpt.parent_path());
+    if (kind == "empty") test::write_text(ckpt, "");
+    if (kind == "garbage") test::write_text(ckpt, std::string(4096, 'g'));
+    if (kind == "flipped") std::ofstream(ckpt, std::ios::binary) << bytes;
+    if (kind == "foreign") std::ofstream(ckpt, std::ios::binary) << foreign;
+    if (kind == "directory") fs::create_directory(ckpt);
+    if (kind == "fifo") ASSERT_EQ(::mkfifo(ckpt.c_str(), 0600), 0);
+    const test::CliResult r = run_cli(dir.path(), "study s.json --db " + db + " --jobs 1 --quiet");
+    EXPECT_EQ(r.code, 0) << kind << ": " << r.err;
+    EXPECT_NE(r.err.find("crevasse: warning: "), std::string::npos) << kind << ": " << r.err;
+    EXPECT_NE(r.err.find(reason), std::string::npos) << kind << ": " << r.err;
+    EXPECT_NE(r.err.find("the case runs from t = 0"), std::string::npos) << kind << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << kind << ": " << r.err;
+    EXPECT_EQ(one_value(dir / db, "SELECT json_extract(run_json, '$.resumed_from_time_s') FROM cases"), "-1.0");
+    EXPECT_EQ(test::result_dump(dir / db), test::result_dump(dir / "ref.db")) << kind;
+    EXPECT_FALSE(fs::exists(fs::symlink_status(ckpt))) << kind;
+  }
+}
+
+// A checkpoint that cannot be written (here: a directory where its temporary file goes) warns
+// and the case goes on to the uninterrupted result; a regular file where the checkpoint folder
+// belongs is refused with exit 2 and its path before any database exists.
+TEST(Reliability, FailedCheckpointWriteWarnsAndTheCaseGoesOn) {
+  test::ScratchDir dir("rel_ckpt_write");
+  test::write_text(dir / "s.json", checkpointed_study(1500).dump(2));
+  ASSERT_EQ(run_cli(dir.path(), "study s.json --db ref.db --jobs 1 --quiet").code, 0);
+  const std::string case_id = one_value(dir / "ref.db", "SELECT case_id FROM cases");
+  fs::create_directories(dir / "k.db.checkpoints" / (case_id + ".ckpt.tmp"));
+  const test::CliResult r = run_cli(dir.path(), "study s.json --db k.db --jobs 1 --quiet");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("crevasse: warning: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the case goes on without it"), std::string::npos) << r.err;
+  EXPECT_EQ(one_value(dir / "k.db", "SELECT status FROM cases"), "done");
+  EXPECT_EQ(test::result_dump(dir / "k.db"), test::result_dump(dir / "ref.db"));
+  EXPECT_TRUE(fs::is_directory(dir / "k.db.checkpoints" / (case_id + ".ckpt.tmp"))) << "not ours to remove";
+
+  test::write_text(dir / "f.db.checkpoints", "a file");
+  const test::CliResult f = run_cli(dir.path(), "study s.json --db f.db --jobs 1 --quiet");
+  EXPECT_EQ(f.code, 2) << f.err;
+  EXPECT_NE(f.err.find("f.db.checkpoints"), std::string::npos) << f.err;
+  EXPECT_NE(f.err.find("checkpoint_interval_s"), std::string::npos) << f.err;
+  EXPECT_FALSE(fs::exists(dir / "f.db"));
+}
+
+// The settling phase is a phase like the run, on a case whose settling lasts many seconds:
+// SIGTERM ends the study within a few seconds with the case pending and a checkpoint written
+// while settling; the case time limit fires while settling; the same command then continues
+// from the settling checkpoint to the uninterrupted result.
+TEST(Reliability, SettlingHonoursSignalsTimeLimitAndCheckpoints) {
+  test::ScratchDir dir("rel_settle");
+  nlohmann::json study = checkpointed_study(100);
+  study["base_scene"]["ice"]["settle_time"] = 800.0;  // about 190,000 steps: 4-8 s
+  study["resources"]["checkpoint_interval_s"] = 0.3;
+  test::write_text(dir / "s.json", study.dump(2));
+
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_EQ(run_cli(dir.path(), "study s.json --db ref.db --jobs 1 --quiet").code, 0);
+  const double whole_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_GT(whole_s, 4.0) << "settling is too short to tell; raise settle_time";
+
+  const pid_t pid = test::spawn_crevasse(study_args(dir.path(), "k.db"), (dir / "k_err.txt").string());
+  ASSERT_GT(pid, 0);
+  ASSERT_FALSE(wait_for_checkpoint(dir / "k.db.checkpoints").empty());
+  const Ended e = signal_and_wait(pid, SIGTERM);
+  ASSERT_TRUE(WIFEXITED(e.status));
+  EXPECT_EQ(WEXITSTATUS(e.status), 143) << read_file(dir / "k_err.txt");
+  // The poll is every 0.5 s of wall time; the rest is the checkpoint and closing the session.
+  EXPECT_LT(e.seconds, whole_s / 2) << "the signal waited for the settling phase to end";
+  EXPECT_EQ(one_value(dir / "k.db", "SELECT status FROM cases"), "pending");
+
+  const test::CliResult limited = run_cli(dir.path(), "study s.json --db t.db --jobs 1 --quiet --case-time-limit 1");
+  EXPECT_EQ(limited.code, 1) << limited.err;
+  const std::string reason = one_value(dir / "t.db", "SELECT failure_reason FROM cases");
+  EXPECT_NE(reason.find("while settling"), std::string::npos) << reason;
+
+  const test::CliResult resumed = run_cli(dir.path(), "study s.json --db k.db --jobs 1 --quiet");
+  ASSERT_EQ(resumed.code, 0) << resumed.err;
+  EXPECT_GT(std::stod(one_value(dir / "k.db", "SELECT json_extract(run_json, '$.resumed_from_time_s') FROM cases")), 0.0);
+  EXPECT_EQ(test::result_dump(dir / "k.db"), test::result_dump(dir / "ref.db"));
+}
+
+}  // namespace
+}  // namespace crevasse
