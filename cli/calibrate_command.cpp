@@ -1,4 +1,5 @@
 #include "cli/calibrate_command.hpp"
+#include "cli/cli_common.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -294,6 +295,7 @@ int calibrate_command(const CalibrateCommandOptions& opt) {
   if (!opt.observations_path.empty()) {
     if (opt.spacing_m != 0.0 || !opt.spacing_quartiles.empty() || opt.thickness_m)
       throw InputError("--observations: give either --observations or --spacing [--spacing-quartiles] [--thickness], not both");
+    if (!opt.csv_path.empty()) check_output_file("--csv", opt.csv_path);
     return calibrate_observations(opt);
   }
   if (!opt.csv_path.empty()) throw InputError("--csv: only with --observations");

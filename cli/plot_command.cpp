@@ -80,6 +80,7 @@ std::vector<const CaseRecord*> default_cdf_cases(const std::vector<CaseRecord>& 
 }  // namespace
 
 std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
+  check_output_directory("--out", opt.out_dir);
   const FitGroup& group = find_fit_group(opt.group, "--group");
   const FitGroup& colour_by = find_fit_group(opt.colour_by, "--colour-by");
   if (opt.model != "auto" && opt.model != "single" && opt.model != "broken" && opt.model != "none")

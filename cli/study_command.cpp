@@ -145,6 +145,16 @@ int study_command(const StudyCommandOptions& opt) {
     return 0;
   }
 
+  if (!opt.views_dir.empty()) {
+    std::vector<std::string> views;
+    for (const StudyCase& c : study.cases) {
+      char stem[32];
+      std::snprintf(stem, sizeof stem, "case_%03zu_", c.index);
+      views.push_back(std::string(stem) + "side_view.png");
+      views.push_back(std::string(stem) + "gate_view.png");
+    }
+    check_output_directory("--views", opt.views_dir, views);
+  }
   std::string db = opt.db_path;
   if (db.empty()) {
     db = "results/" + study.name;

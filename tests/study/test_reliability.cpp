@@ -190,3 +190,43 @@ TEST(Reliability, SettlingHonoursSignalsTimeLimitAndCheckpoints) {
 
 }  // namespace
 }  // namespace crevasse
+
+namespace crevasse {
+namespace {
+
+// Every output path is checked before any work, as input paths are: an output folder that is
+// a file, or a file in it that is a folder, is refused with exit 2 and a line naming the
+// option and the path, before a case is simulated, a database is created or a file is written.
+TEST(Reliability, OutputPathsAreCheckedBeforeAnyWork) {
+  test::ScratchDir dir("rel_outputs");
+  test::write_text(dir / "s.json", test::tiny_study(2, 200, "outs").dump(2));
+  test::write_text(dir / "a_file", "x");
+  auto refused = [&](const std::string& args, const std::string& names) {
+    const test::CliResult r = run_cli(dir.path(), args);
+    EXPECT_EQ(r.code, 2) << args << ": " << r.err;
+    EXPECT_NE(r.err.find(names), std::string::npos) << args << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << ": " << r.err;
+  };
+  refused("study s.json --db v.db --views a_file --quiet", "--views: ");
+  refused("study s.json --db v.db --views a_file/sub --quiet", "a_file");
+  fs::create_directories(dir / "views" / "case_001_side_view.png");
+  refused("study s.json --db v.db --views views --quiet", "case_001_side_view.png");
+  EXPECT_FALSE(fs::exists(dir / "v.db")) << "refused, yet the study began";
+
+  fs::create_directories(dir / "run_out" / "run_summary.json");
+  test::write_text(dir / "scene.json", test::tiny_scene(200).dump());
+  refused("run scene.json --out run_out --quiet", "run_summary.json");
+  EXPECT_FALSE(fs::exists(dir / "run_out" / "scene_resolved.json")) << "written before the check";
+  refused("run scene.json --out a_file --quiet", "--out: ");
+
+  ASSERT_EQ(run_cli(dir.path(), "study s.json --db s.db --quiet").code, 0);
+  fs::create_directories(dir / "csv" / "cases.csv");
+  refused("export s.db --csv csv", "cases.csv");
+  EXPECT_FALSE(fs::exists(dir / "csv" / "study.csv")) << "some tables written before the refusal";
+  refused("export s.db --csv a_file", "--csv: ");
+  refused("plot s.db --out a_file", "--out: ");
+  refused("accuracy s.db --out a_file", "--out: ");
+}
+
+}  // namespace
+}  // namespace crevasse
