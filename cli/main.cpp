@@ -1,9 +1,11 @@
 // The crevasse command line. Every error is caught here, printed on one line, and mapped to an
 // exit code: 2 for bad input, 1 for a failed simulation or any other error.
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <optional>
 #include <string>
@@ -62,7 +64,9 @@ std::string version_text() {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+namespace {
+
+int run_command_line(int argc, char** argv) {
   CLI::App app{"crevasse: scaling laws of glacier fracture from MPM parameter studies"};
   app.require_subcommand(1);
   app.set_version_flag("--version", version_text(),
@@ -204,3 +208,23 @@ int main(int argc, char** argv) {
   }
   return 0;
 }
+
+// Output that never reached the user is an error: a full disk or a closed pipe behind stdout
+// (or stderr) turns an exit code 0 into 1.
+int check_streams(int code) {
+  errno = 0;
+  if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+    const int err = errno;
+    std::fprintf(stderr, "crevasse: error: writing to standard output failed (%s)\n",
+                 err ? std::strerror(err) : "write error");
+    if (code == 0) code = 1;
+  }
+  if (std::fflush(stderr) != 0 || std::ferror(stderr)) {
+    if (code == 0) code = 1;
+  }
+  return code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) { return check_streams(run_command_line(argc, argv)); }

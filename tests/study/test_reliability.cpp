@@ -13,6 +13,8 @@
 #include <iterator>
 #include <thread>
 
+#include <sqlite3.h>
+
 #include "study_test_support.hpp"
 
 namespace crevasse {
@@ -188,11 +190,6 @@ TEST(Reliability, SettlingHonoursSignalsTimeLimitAndCheckpoints) {
   EXPECT_EQ(test::result_dump(dir / "k.db"), test::result_dump(dir / "ref.db"));
 }
 
-}  // namespace
-}  // namespace crevasse
-
-namespace crevasse {
-namespace {
 
 // Every output path is checked before any work, as input paths are: an output folder that is
 // a file, or a file in it that is a folder, is refused with exit 2 and a line naming the
@@ -226,6 +223,35 @@ TEST(Reliability, OutputPathsAreCheckedBeforeAnyWork) {
   refused("export s.db --csv a_file", "--csv: ");
   refused("plot s.db --out a_file", "--out: ");
   refused("accuracy s.db --out a_file", "--out: ");
+}
+
+
+// Exit status of `crevasse ARGS > /dev/full` run in `dir`, and its stderr.
+test::CliResult to_full_disk(const fs::path& dir, const std::string& args, const std::string& err = "2> cli_err.txt") {
+  const std::string cmd = "cd '" + dir.string() + "' && '" CREVASSE_BINARY "' " + args + " > /dev/full " + err;
+  const int status = std::system(cmd.c_str());
+  test::CliResult r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.err = read_file(dir / "cli_err.txt");
+  return r;
+}
+
+// Lost output is an error: every command that prints its result exits non-zero, saying so,
+// when standard output cannot be written (here /dev/full, as on a full disk), and so does one
+// whose standard error cannot be written either.
+TEST(Reliability, LostOutputIsAnError) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  test::ScratchDir dir("rel_lost");
+  test::write_text(dir / "s.json", test::tiny_study(3, 200, "lost").dump(2));
+  ASSERT_EQ(run_cli(dir.path(), "study s.json --db s.db --quiet").code, 0);
+  for (const std::string args : {"status s.db", "status s.db --all", "export s.db --csv csv",
+                                 "study s.json --dry-run", "fit s.db --no-store", "--version", "--help"}) {
+    const test::CliResult r = to_full_disk(dir.path(), args);
+    EXPECT_NE(r.code, 0) << args;
+    EXPECT_NE(r.err.find("writing to standard output failed"), std::string::npos) << args << ": " << r.err;
+  }
+  EXPECT_NE(to_full_disk(dir.path(), "status s.db", "2> /dev/full").code, 0);
+  EXPECT_EQ(run_cli(dir.path(), "status s.db").code, 0);
 }
 
 }  // namespace
