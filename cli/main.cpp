@@ -7,8 +7,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <new>
 #include <optional>
 #include <string>
+#include <system_error>
 
 #include "cli/accuracy_command.hpp"
 #include "cli/calibrate_command.hpp"
@@ -202,6 +204,15 @@ int run_command_line(int argc, char** argv) {
   } catch (const crevasse::SimulationError& e) {
     std::fprintf(stderr, "crevasse: simulation failed: %s\n", one_line(e.what()).c_str());
     return 1;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "crevasse: error: out of memory; free memory or raise the limit (ulimit -v), "
+                         "then run the same command again\n");
+    return 1;
+  } catch (const std::system_error& e) {
+    std::fprintf(stderr, "crevasse: error: the system refused a resource (%s); free memory or raise "
+                         "the limits (ulimit -u, -v), then run the same command again\n",
+                 one_line(e.what()).c_str());
+    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "crevasse: error: %s\n", one_line(e.what()).c_str());
     return 1;
@@ -225,6 +236,24 @@ int check_streams(int code) {
   return code;
 }
 
+// Memory set aside for running out of it: nlohmann::json's destructor allocates, so a failed
+// allocation while a case unwinds would end the process with SIGABRT, and closing the session
+// needs memory too. The first failed allocation frees the reserve and throws std::bad_alloc;
+// the unwinding then has room.
+char* g_memory_reserve = nullptr;
+
+void release_memory_reserve() {
+  if (!g_memory_reserve) throw std::bad_alloc();
+  delete[] g_memory_reserve;
+  g_memory_reserve = nullptr;
+  std::set_new_handler(nullptr);
+  throw std::bad_alloc();
+}
+
 }  // namespace
 
-int main(int argc, char** argv) { return check_streams(run_command_line(argc, argv)); }
+int main(int argc, char** argv) {
+  g_memory_reserve = new (std::nothrow) char[16u << 20];
+  if (g_memory_reserve) std::set_new_handler(release_memory_reserve);
+  return check_streams(run_command_line(argc, argv));
+}

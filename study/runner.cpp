@@ -173,6 +173,24 @@ class StudyRun {
 
   RunnerReport run() {
     set_up();
+    try {
+      return run_cases();
+    } catch (...) {
+      // Out of memory or threads, or a store that failed: the running cases go back to pending
+      // and the session is closed, so that the next session neither waits for nor reruns
+      // anything by mistake. Best effort: the store may be what failed.
+      stop().store(true);
+      try {
+        store_.reset_running();
+        store_.end_session(report_.session_id, "stopped", static_cast<std::int64_t>(report_.ran));
+      } catch (...) {
+      }
+      throw;
+    }
+  }
+
+ private:
+  RunnerReport run_cases() {
     const int jobs = std::max(
         1, std::min<int>(report_.jobs, static_cast<int>(std::max<std::size_t>(todo_.size(), 1))));
     // Workers: `jobs` loops, each taking the next case; each case runs in its own arena so that
@@ -187,22 +205,29 @@ class StudyRun {
     // queues, in an uninstrumented libtbb, are not). Each case still runs in its own task arena.
     std::exception_ptr worker_error;
     std::mutex worker_error_mutex;
+    auto keep_error = [&] {
+      const std::lock_guard<std::mutex> lock(worker_error_mutex);
+      if (!worker_error) worker_error = std::current_exception();
+      stop().store(true);
+    };
     std::thread executor([&] {
       std::vector<std::thread> workers;
-      for (int j = 0; j < jobs; ++j)
-        workers.emplace_back([&] {
-          try {
-            while (!stop().load()) {
-              const std::size_t slot = next_.fetch_add(1);
-              if (slot >= todo_.size()) return;
-              run_case(slot);
+      try {
+        for (int j = 0; j < jobs; ++j)
+          workers.emplace_back([&] {
+            try {
+              while (!stop().load()) {
+                const std::size_t slot = next_.fetch_add(1);
+                if (slot >= todo_.size()) return;
+                run_case(slot);
+              }
+            } catch (...) {
+              keep_error();
             }
-          } catch (...) {
-            const std::lock_guard<std::mutex> lock(worker_error_mutex);
-            if (!worker_error) worker_error = std::current_exception();
-            stop().store(true);
-          }
-        });
+          });
+      } catch (...) {  // a thread the system would not start ends the run like a worker's error
+        keep_error();
+      }
       for (auto& w : workers) w.join();
       queue_.close();
     });
@@ -213,7 +238,6 @@ class StudyRun {
     return finish();
   }
 
- private:
   std::atomic<bool>& stop() { return opt_.interrupt ? *opt_.interrupt : own_stop_; }
 
   void set_up() {

@@ -190,7 +190,6 @@ TEST(Reliability, SettlingHonoursSignalsTimeLimitAndCheckpoints) {
   EXPECT_EQ(test::result_dump(dir / "k.db"), test::result_dump(dir / "ref.db"));
 }
 
-
 // Every output path is checked before any work, as input paths are: an output folder that is
 // a file, or a file in it that is a folder, is refused with exit 2 and a line naming the
 // option and the path, before a case is simulated, a database is created or a file is written.
@@ -225,7 +224,6 @@ TEST(Reliability, OutputPathsAreCheckedBeforeAnyWork) {
   refused("accuracy s.db --out a_file", "--out: ");
 }
 
-
 // Exit status of `crevasse ARGS > /dev/full` run in `dir`, and its stderr.
 test::CliResult to_full_disk(const fs::path& dir, const std::string& args, const std::string& err = "2> cli_err.txt") {
   const std::string cmd = "cd '" + dir.string() + "' && '" CREVASSE_BINARY "' " + args + " > /dev/full " + err;
@@ -252,6 +250,42 @@ TEST(Reliability, LostOutputIsAnError) {
   }
   EXPECT_NE(to_full_disk(dir.path(), "status s.db", "2> /dev/full").code, 0);
   EXPECT_EQ(run_cli(dir.path(), "status s.db").code, 0);
+}
+
+// Out of memory is one line and exit 1, never SIGABRT: under address-space limits from "no
+// thread can start" to "enough", each run ends with exit 0 or 1 and at most one line, leaves
+// no case running (each is pending, failed with its reason, or done) and closes its session;
+// the same command without the limit then completes the study to the uninterrupted result.
+TEST(Reliability, OutOfMemoryIsOneLineAndLeavesTheStudyResumable) {
+  test::ScratchDir dir("rel_oom");
+  test::write_text(dir / "s.json", test::tiny_study(2, 300, "oom").dump(2));
+  ASSERT_EQ(run_cli(dir.path(), "study s.json --db ref.db --jobs 2 --quiet").code, 0);
+  int ran_out = 0;
+  for (int kib = 40000; kib <= 84000; kib += 4000) {
+    const std::string db = "m" + std::to_string(kib) + ".db";
+    const std::string cmd = "cd '" + dir.path().string() + "' && bash -c \"ulimit -v " + std::to_string(kib) +
+                            "; exec '" CREVASSE_BINARY "' study s.json --db " + db +
+                            " --jobs 2 --quiet\" > /dev/null 2> err.txt";
+    const int status = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(status)) << kib << " KiB: killed by a signal";
+    const int code = WEXITSTATUS(status);
+    const std::string err = read_file(dir / "err.txt");
+    EXPECT_TRUE(code == 0 || code == 1) << kib << " KiB: exit " << code << ": " << err;
+    if (code != 0) {
+      ++ran_out;
+      EXPECT_EQ(err.rfind("crevasse: ", 0), 0u) << kib << " KiB: " << err;
+      EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << kib << " KiB: " << err;
+    }
+    if (!fs::exists(dir / db)) continue;
+    EXPECT_EQ(one_value(dir / db, "SELECT count(*) FROM cases WHERE status = 'running'"), "0") << kib;
+    EXPECT_EQ(one_value(dir / db, "SELECT count(*) FROM cases WHERE status = 'failed' AND "
+                                  "coalesce(failure_reason, '') = ''"), "0") << kib;
+    EXPECT_EQ(one_value(dir / db, "SELECT count(*) FROM sessions WHERE outcome IS NULL"), "0") << kib;
+    const test::CliResult again = run_cli(dir.path(), "study s.json --db " + db + " --jobs 2 --retry-failed --quiet");
+    EXPECT_EQ(again.code, 0) << kib << ": " << again.err;
+    EXPECT_EQ(test::result_dump(dir / db), test::result_dump(dir / "ref.db")) << kib;
+  }
+  EXPECT_GT(ran_out, 0) << "no limit ran out of memory; lower the first one";
 }
 
 }  // namespace
