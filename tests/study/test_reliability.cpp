@@ -288,5 +288,65 @@ TEST(Reliability, OutOfMemoryIsOneLineAndLeavesTheStudyResumable) {
   EXPECT_GT(ran_out, 0) << "no limit ran out of memory; lower the first one";
 }
 
+
+std::string bytes_of(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
+
+// Foreign files stay untouched: an SQLite database of another program is refused by every
+// command that writes a study database (study --db, merge's OUT), with exit 2 and its path,
+// before anything writes to it (no WAL switch, no -wal or -shm), whatever its user_version,
+// and so is a file that is not SQLite at all.
+TEST(Reliability, ForeignDatabasesAreRefusedUntouched) {
+  test::ScratchDir dir("rel_foreign");
+  test::write_text(dir / "s.json", test::tiny_study(2, 100, "foreign").dump(2));
+  ASSERT_EQ(run_cli(dir.path(), "study s.json --db in.db --quiet").code, 0);
+  const std::vector<std::pair<std::string, std::string>> foreign = {
+      {"v0.db", "CREATE TABLE notes(x); PRAGMA user_version = 0;"},
+      {"v1.db", "CREATE TABLE notes(x); PRAGMA user_version = 1;"},
+      {"v2.db", "CREATE TABLE cases(x); CREATE TABLE study(y); PRAGMA user_version = 2;"},
+      {"v7.db", "CREATE TABLE notes(x); PRAGMA user_version = 7;"},
+      {"empty_v5.db", "PRAGMA user_version = 5;"},
+  };
+  std::vector<std::string> names;
+  for (const auto& [name, sql] : foreign) {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open((dir / name).c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK) << name;
+    sqlite3_close(db);
+    names.push_back(name);
+  }
+  test::write_text(dir / "text.db", std::string(2048, 't'));
+  names.push_back("text.db");
+  for (const std::string& name : names) {
+    const std::string before = bytes_of(dir / name);
+    for (const std::string args : {"study s.json --quiet --db " + name, "merge " + name + " in.db"}) {
+      const test::CliResult r = run_cli(dir.path(), args);
+      EXPECT_EQ(r.code, 2) << args << ": " << r.err;
+      EXPECT_NE(r.err.find(name), std::string::npos) << args << ": " << r.err;
+      EXPECT_NE(r.err.find("not a crevasse study database"), std::string::npos) << args << ": " << r.err;
+      EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << ": " << r.err;
+      EXPECT_EQ(bytes_of(dir / name), before) << args << ": the file changed";
+      EXPECT_FALSE(fs::exists(dir / (name + "-wal"))) << args;
+      EXPECT_FALSE(fs::exists(dir / (name + "-shm"))) << args;
+    }
+  }
+}
+
+// A refused --db leaves no file under a resource failure: with the file-size limit at zero
+// (as on a full disk) a new database cannot be begun, and neither it nor its -wal is left.
+TEST(Reliability, RefusedDatabaseLeavesNoFile) {
+  test::ScratchDir dir("rel_refused_db");
+  test::write_text(dir / "s.json", test::tiny_study(2, 100, "refused").dump(2));
+  const std::string cmd = "cd '" + dir.path().string() +
+                          "' && bash -c \"trap '' XFSZ; ulimit -f 0; exec '" CREVASSE_BINARY
+                          "' study s.json --db new/k.db --quiet\" 2> /dev/null";
+  const int status = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 2);  // (the message cannot reach err.txt: it is a file, too)
+  EXPECT_FALSE(fs::exists(dir / "new")) << "a refused --db left files behind";
+}
+
 }  // namespace
 }  // namespace crevasse
