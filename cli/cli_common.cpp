@@ -56,6 +56,14 @@ void check_output_file(const std::string& option, const fs::path& file) {
     throw InputError(option + ": " + file.string() + " exists and is not a regular file");
 }
 
+void check_confidence_level(double level) {
+  if (!(level > 0.5 && level < 1.0))
+    throw InputError("--level: " + format_number(level, "%.17g") + " is outside (0.5, 1)");
+  if (format_number(level, "%.4g") == "1")
+    throw InputError("--level: " + format_number(level, "%.17g") +
+                     " rounds to 1 (its intervals would be infinite); the largest is 0.9999");
+}
+
 std::vector<fs::path> write_png_and_svg(const analysis::Figure& figure, const fs::path& stem) {
   const fs::path png = stem.string() + ".png", svg = stem.string() + ".svg";
   figure.write_png(png.string());

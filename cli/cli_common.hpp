@@ -28,6 +28,10 @@ void check_output_directory(const std::string& option, const std::filesystem::pa
 // The same for one output file: its folder as above, the file absent or a regular file.
 void check_output_file(const std::string& option, const std::filesystem::path& file);
 
+// --level of fit, calibrate and predict: in (0.5, 1), and below 1 as the tables show it (4
+// significant digits): a level that rounds to 1 has infinite intervals. InputError otherwise.
+void check_confidence_level(double level);
+
 // Writes `figure` as <stem>.png and <stem>.svg; returns the two paths, PNG first.
 std::vector<std::filesystem::path> write_png_and_svg(const analysis::Figure& figure,
                                                      const std::filesystem::path& stem);

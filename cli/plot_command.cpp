@@ -114,6 +114,8 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
     added_names.push_back(study_name(other, path));
     added.push_back(read_case_records(other));
   }
+  // The fits table is read while drawing; an inconsistent row is refused here, before the folder.
+  for (Quantity q : kQuantities) read_fit_records(store, quantity_key(q), group.name);
   // Only once every input has been read: a refusal leaves no folder behind.
   create_output_directory("--out", opt.out_dir);
   std::vector<std::pair<const CaseRecord*, std::string>> drawn_cases;

@@ -7,6 +7,7 @@
 #include <cctype>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
@@ -192,6 +193,10 @@ double Statement::real(int c) const { return sqlite3_column_double(stmt_, c); }
 std::int64_t Statement::integer(int c) const { return sqlite3_column_int64(stmt_, c); }
 std::optional<std::string> Statement::optional_text(int c) const {
   return is_null(c) ? std::nullopt : std::optional<std::string>(text(c));
+}
+bool Statement::is_finite_number(int c) const {
+  const int type = sqlite3_column_type(stmt_, c);
+  return (type == SQLITE_INTEGER || type == SQLITE_FLOAT) && std::isfinite(real(c));
 }
 std::optional<double> Statement::optional_real(int c) const {
   return is_null(c) ? std::nullopt : std::optional<double>(real(c));

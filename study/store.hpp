@@ -54,6 +54,9 @@ class Statement {
   std::int64_t integer(int c) const;
   std::optional<std::string> optional_text(int c) const;
   std::optional<double> optional_real(int c) const;
+  // Whether column c holds a finite number (an INTEGER or REAL value): a TEXT or BLOB value, which
+  // real() would read as 0, or an infinity, is not data of a numeric column.
+  bool is_finite_number(int c) const;
 
  private:
   sqlite3* db_;

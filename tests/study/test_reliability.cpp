@@ -288,7 +288,6 @@ TEST(Reliability, OutOfMemoryIsOneLineAndLeavesTheStudyResumable) {
   EXPECT_GT(ran_out, 0) << "no limit ran out of memory; lower the first one";
 }
 
-
 std::string bytes_of(const fs::path& p) {
   std::ifstream f(p, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(f), {});
@@ -346,6 +345,54 @@ TEST(Reliability, RefusedDatabaseLeavesNoFile) {
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 2);  // (the message cannot reach err.txt: it is a file, too)
   EXPECT_FALSE(fs::exists(dir / "new")) << "a refused --db left files behind";
+}
+
+void sql(const fs::path& db, const std::string& statement) {
+  sqlite3* h = nullptr;
+  ASSERT_EQ(sqlite3_open(db.c_str(), &h), SQLITE_OK);
+  char* err = nullptr;
+  EXPECT_EQ(sqlite3_exec(h, statement.c_str(), nullptr, nullptr, &err), SQLITE_OK) << (err ? err : "");
+  sqlite3_free(err);
+  sqlite3_close(h);
+}
+
+// Inconsistent databases are reported, not read as data: a fits value that is text or infinite,
+// a fits level outside (0.5, 1), a done case without its summaries row and a summaries value
+// that is text each make every command that reads them refuse with exit 2 and one line naming
+// the row and the column; and a --level that rounds to 1 is refused before anything is fitted.
+TEST(Reliability, InconsistentDatabasesAreReportedNotReadAsData) {
+  test::ScratchDir dir("rel_inconsistent");
+  test::write_text(dir / "s.json", test::tiny_study(3, 200, "incons").dump(2));
+  ASSERT_EQ(run_cli(dir.path(), "study s.json --db s.db --quiet").code, 0);
+  ASSERT_EQ(run_cli(dir.path(), "fit s.db").code, 0);
+  auto refused = [&](const std::string& args, const std::string& names) {
+    const test::CliResult r = run_cli(dir.path(), args);
+    EXPECT_EQ(r.code, 2) << args << ": " << r.err;
+    EXPECT_NE(r.err.find(names), std::string::npos) << args << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << ": " << r.err;
+  };
+  const std::string predict = "predict --db s.db --cohesion 100000 --thickness 100";
+  for (const std::string level : {"0.9999999999999999", "0.99999"}) {
+    refused("fit s.db --level " + level, "rounds to 1");
+    refused(predict + " --level " + level, "rounds to 1");
+  }
+
+  fs::copy_file(dir / "s.db", dir / "good.db");
+  sql(dir / "s.db", "UPDATE fits SET exponent = 'abc' WHERE rowid = (SELECT min(rowid) FROM fits)");
+  refused(predict, "column exponent holds 'abc'");
+  refused("plot s.db --out plots", "column exponent holds 'abc'");
+  sql(dir / "s.db", "UPDATE fits SET exponent = NULL, exponent_lo = 9e999");
+  refused(predict, "column exponent_lo holds 'Inf'");
+  sql(dir / "s.db", "UPDATE fits SET exponent_lo = NULL, level = 1");
+  refused(predict, "level 1.0 is outside (0.5, 1)");
+
+  fs::copy_file(dir / "good.db", dir / "s.db", fs::copy_options::overwrite_existing);
+  sql(dir / "s.db", "UPDATE summaries SET spacing_count = 'many' WHERE rowid = (SELECT min(rowid) FROM summaries)");
+  refused("fit s.db --no-store", "summaries.spacing_count holds 'many'");
+  sql(dir / "s.db", "DELETE FROM summaries WHERE rowid = (SELECT min(rowid) FROM summaries)");
+  refused("fit s.db --no-store", "is done but has no summaries row");
+  refused("plot s.db --out plots", "is done but has no summaries row");
+  EXPECT_FALSE(fs::exists(dir / "plots"));
 }
 
 }  // namespace
