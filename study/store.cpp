@@ -440,6 +440,23 @@ Store Store::open_reader(const fs::path& path) {
   return store;
 }
 
+bool Store::is_blank(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return false;
+  if (fs::file_size(path, ec) == 0 && !ec) return true;
+  sqlite3* db = nullptr;
+  bool blank = false;
+  if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) == SQLITE_OK) {
+    try {
+      blank = read_user_version(db) == 0 && table_count(db) == 0;
+    } catch (const std::exception&) {
+      blank = false;  // not SQLite: not ours to replace
+    }
+  }
+  sqlite3_close_v2(db);
+  return blank;
+}
+
 int Store::schema_version() const { return read_user_version(db_); }
 
 std::string Store::under_resolved_column() const {

@@ -111,6 +111,9 @@ class Store {
   // Opens an existing database read-only. Throws InputError when it does not exist or is not a
   // crevasse study database.
   static Store open_reader(const std::filesystem::path& path);
+  // Whether `path` is an empty file or an SQLite database with no table and user_version 0: the
+  // shell a writer killed before it wrote the schema leaves, which holds nothing to keep.
+  static bool is_blank(const std::filesystem::path& path);
 
   Store(Store&& other) noexcept;
   Store& operator=(Store&&) = delete;

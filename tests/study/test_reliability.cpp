@@ -9,9 +9,11 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <functional>
 #include <fstream>
 #include <iterator>
 #include <thread>
+#include <tuple>
 
 #include <sqlite3.h>
 
@@ -393,6 +395,143 @@ TEST(Reliability, InconsistentDatabasesAreReportedNotReadAsData) {
   refused("fit s.db --no-store", "is done but has no summaries row");
   refused("plot s.db --out plots", "is done but has no summaries row");
   EXPECT_FALSE(fs::exists(dir / "plots"));
+}
+
+// Starts crevasse with `args` in `dir`, SIGKILLs it after `delay`, and waits for it; true when
+// the kill landed (the command had not finished).
+bool kill_after(const fs::path& dir, std::vector<std::string> args, std::chrono::microseconds delay) {
+  for (auto& a : args)
+    if (a.find('/') == std::string::npos && (a.ends_with(".db") || a == "csv" || a == "plots")) a = (dir / a).string();
+  const pid_t pid = test::spawn_crevasse(args, (dir / "killed_err.txt").string());
+  EXPECT_GT(pid, 0);
+  std::this_thread::sleep_for(delay);
+  ::kill(pid, SIGKILL);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return WIFSIGNALED(status);
+}
+
+double seconds_of(const std::function<void()>& f) {
+  const auto t0 = std::chrono::steady_clock::now();
+  f();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void remove_db(const fs::path& db) {
+  for (const char* suffix : {"", "-wal", "-shm"}) fs::remove(db.string() + suffix);
+}
+
+// Files appear whole or not at all: SIGKILL at spread-out moments of fit, export, plot and
+// merge (6 each) leaves every file either as it was or whole as an uninterrupted run writes it,
+// a fits table with the old rows or all the new ones, and no OUT or the whole merge; a retried
+// merge then completes.
+TEST(Reliability, KillsDuringFitExportPlotAndMergeLeaveOldOrWholeNew) {
+  test::ScratchDir dir("rel_kills");
+  test::write_text(dir / "s.json", test::tiny_study(6, 300, "kills").dump(2));
+  ASSERT_EQ(run_cli(dir.path(), "study s.json --db s.db --quiet").code, 0);
+  ASSERT_EQ(run_cli(dir.path(), "fit s.db --group all --level 0.9").code, 0);
+  fs::copy_file(dir / "s.db", dir / "old.db");
+  fs::copy_file(dir / "s.db", dir / "new.db");
+  const std::string fits = "SELECT quantity, group_name, model, regime, status, level, exponent FROM fits ORDER BY 1, 2, 3, 4";
+  const double fit_s = seconds_of([&] { ASSERT_EQ(run_cli(dir.path(), "fit new.db --group all --level 0.8").code, 0); });
+  const auto old_rows = test::dump_rows(dir / "old.db", fits), new_rows = test::dump_rows(dir / "new.db", fits);
+  ASSERT_NE(old_rows, new_rows);
+  const double export_s = seconds_of([&] { ASSERT_EQ(run_cli(dir.path(), "export s.db --csv ref_csv").code, 0); });
+  const double plot_s = seconds_of([&] { ASSERT_EQ(run_cli(dir.path(), "plot s.db --out ref_plots").code, 0); });
+  const double merge_s = seconds_of([&] { ASSERT_EQ(run_cli(dir.path(), "merge ref_m.db s.db").code, 0); });
+  // A file of `got` is either "old" (as placed before the kill) or the reference's bytes.
+  auto old_or_whole = [&](const fs::path& got, const fs::path& ref) {
+    for (const auto& e : fs::directory_iterator(ref)) {
+      const fs::path f = got / e.path().filename();
+      if (!fs::exists(f)) continue;
+      const std::string bytes = bytes_of(f);
+      EXPECT_TRUE(bytes == "old" || bytes == bytes_of(e.path())) << f << ": a partial file";
+    }
+  };
+  auto place_old = [&](const fs::path& got, const fs::path& ref) {
+    fs::create_directories(got);
+    for (const auto& e : fs::directory_iterator(ref)) test::write_text(got / e.path().filename(), "old");
+  };
+  constexpr int kKills = 6;
+  int landed = 0;
+  for (int k = 0; k < kKills; ++k) {
+    const auto at = [&](double whole_s) {
+      return std::chrono::microseconds(static_cast<long>(1e6 * whole_s * (k + 0.5) / kKills));
+    };
+    remove_db(dir / "s.db");
+    fs::copy_file(dir / "old.db", dir / "s.db");
+    landed += kill_after(dir.path(), {"fit", "s.db", "--group", "all", "--level", "0.8"}, at(fit_s));
+    EXPECT_EQ(test::pragma_integrity(dir / "s.db"), "ok");
+    const auto rows = test::dump_rows(dir / "s.db", fits);
+    EXPECT_TRUE(rows == old_rows || rows == new_rows) << "fit killed at kill " << k << ": a mix of rows";
+
+    place_old(dir / "csv", dir / "ref_csv");
+    landed += kill_after(dir.path(), {"export", "old.db", "--csv", "csv"}, at(export_s));
+    old_or_whole(dir / "csv", dir / "ref_csv");
+
+    place_old(dir / "plots", dir / "ref_plots");
+    landed += kill_after(dir.path(), {"plot", "old.db", "--out", "plots"}, at(plot_s));
+    old_or_whole(dir / "plots", dir / "ref_plots");
+
+    remove_db(dir / "m.db");
+    landed += kill_after(dir.path(), {"merge", "m.db", "old.db"}, at(merge_s));
+    if (fs::exists(dir / "m.db")) {
+      EXPECT_EQ(test::pragma_integrity(dir / "m.db"), "ok");
+      EXPECT_EQ(test::result_dump(dir / "m.db"), test::result_dump(dir / "ref_m.db")) << "a partial OUT";
+    }
+    const test::CliResult retry = run_cli(dir.path(), "merge m.db old.db");
+    EXPECT_EQ(retry.code, 0) << retry.err;
+    EXPECT_EQ(test::result_dump(dir / "m.db"), test::result_dump(dir / "ref_m.db"));
+  }
+  EXPECT_GE(landed, 20) << "most commands ended before their kill";
+  // Killed writers' temporary files are removed by the next writer of the same file.
+  ASSERT_EQ(run_cli(dir.path(), "export old.db --csv csv").code, 0);
+  for (const auto& e : fs::directory_iterator(dir / "csv"))
+    EXPECT_NE(e.path().filename().string().front(), '.') << e.path() << " left behind";
+}
+
+// A full disk (here a file-size limit of 4 KiB, with SIGXFSZ ignored) midway through export or
+// plot leaves each file as it was or whole, never truncated, and the command exits non-zero.
+TEST(Reliability, FullDiskLeavesOldOrWholeFiles) {
+  test::ScratchDir dir("rel_full_files");
+  test::write_text(dir / "s.json", test::tiny_study(6, 300, "fullfiles").dump(2));
+  ASSERT_EQ(run_cli(dir.path(), "study s.json --db s.db --quiet").code, 0);
+  ASSERT_EQ(run_cli(dir.path(), "export s.db --csv ref_csv").code, 0);
+  ASSERT_EQ(run_cli(dir.path(), "plot s.db --out ref_plots").code, 0);
+  for (const auto& [args, out, ref] : std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"export s.db --csv csv", "csv", "ref_csv"}, {"plot s.db --out plots", "plots", "ref_plots"}}) {
+    fs::create_directories(dir / out);
+    for (const auto& e : fs::directory_iterator(dir / ref)) test::write_text(dir / out / e.path().filename(), "old");
+    const std::string cmd = "cd '" + dir.path().string() + "' && bash -c \"trap '' XFSZ; ulimit -f 4; exec '" CREVASSE_BINARY
+                            "' " + args + "\" > /dev/null 2>&1";
+    const int status = std::system(cmd.c_str());
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) != 0) << args << ": the limit did not bite";
+    for (const auto& e : fs::directory_iterator(dir / ref)) {
+      const std::string bytes = bytes_of(dir / out / e.path().filename());
+      EXPECT_TRUE(bytes == "old" || bytes == bytes_of(e.path())) << args << ": " << e.path().filename() << " is partial";
+    }
+  }
+}
+
+// Two merges into one new OUT: both succeed (the second waits for the first's lock and then
+// merges into the OUT the first made), in every round.
+TEST(Reliability, ConcurrentMergesIntoOneNewOutBothSucceed) {
+  test::ScratchDir dir("rel_merge_race");
+  nlohmann::json study = test::tiny_study(4, 100, "race");
+  test::write_text(dir / "s.json", study.dump(2));
+  ASSERT_EQ(run_cli(dir.path(), "study s.json --db a.db --shard 0/2 --quiet").code, 0);
+  ASSERT_EQ(run_cli(dir.path(), "study s.json --db b.db --shard 1/2 --quiet").code, 0);
+  for (int round = 0; round < 5; ++round) {
+    remove_db(dir / "m.db");
+    const pid_t a = test::spawn_crevasse({"merge", (dir / "m.db").string(), (dir / "a.db").string()}, (dir / "a_err.txt").string());
+    const pid_t b = test::spawn_crevasse({"merge", (dir / "m.db").string(), (dir / "b.db").string()}, (dir / "b_err.txt").string());
+    int sa = 0, sb = 0;
+    ::waitpid(a, &sa, 0);
+    ::waitpid(b, &sb, 0);
+    EXPECT_TRUE(WIFEXITED(sa) && WEXITSTATUS(sa) == 0) << read_file(dir / "a_err.txt");
+    EXPECT_TRUE(WIFEXITED(sb) && WEXITSTATUS(sb) == 0) << read_file(dir / "b_err.txt");
+    EXPECT_EQ(one_value(dir / "m.db", "SELECT count(*) FROM cases WHERE status = 'done'"), "4") << round;
+  }
 }
 
 }  // namespace
