@@ -206,9 +206,15 @@ MergeReport merge_databases(const fs::path& out, const std::vector<fs::path>& in
     // A blank shell's WAL and shared memory belong to it, not to the new file.
     for (const char* suffix : {"-wal", "-shm"}) fs::remove(out.string() + suffix, ec);
     file.commit();
-  } catch (...) {
+  } catch (const std::runtime_error& e) {
     remove_temp();
-    throw;
+    // The user named OUT, not the file that was to become it.
+    std::string message = e.what();
+    const std::string temp = file.temp_path().string();
+    for (std::size_t at = message.find(temp); at != std::string::npos; at = message.find(temp, at))
+      message.replace(at, temp.size(), out.string());
+    if (dynamic_cast<const InputError*>(&e)) throw InputError(message);
+    throw std::runtime_error(message);
   }
   return report;
 }
