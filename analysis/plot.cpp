@@ -13,6 +13,8 @@
 #include <regex>
 #include <stdexcept>
 
+#include "engine/atomic_file.hpp"
+
 namespace crevasse::analysis {
 namespace {
 
@@ -813,12 +815,14 @@ void Figure::write_png(const std::string& path, double pixels_per_pt) const {
   const int height = static_cast<int>(std::ceil(height_pt_ * pixels_per_pt));
   SurfacePtr surface(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, width, height));
   render(*this, surface.get(), pixels_per_pt);
-  const cairo_status_t status = cairo_surface_write_to_png(surface.get(), path.c_str());
+  AtomicFile file(path);
+  const cairo_status_t status = cairo_surface_write_to_png(surface.get(), file.temp_path().c_str());
   if (status != CAIRO_STATUS_SUCCESS) {
     throw std::runtime_error("figure: cannot write PNG '" + path +
                              "': " + cairo_status_to_string(status) +
                              " — check that the folder exists and is writable");
   }
+  file.commit();
 }
 
 std::string Figure::svg() const {
@@ -853,12 +857,15 @@ std::string Figure::svg() const {
 
 void Figure::write_svg(const std::string& path) const {
   const std::string document = svg();
-  std::ofstream out(path, std::ios::binary);
+  AtomicFile file(path);
+  std::ofstream out(file.temp_path(), std::ios::binary);
   out << document;
+  out.close();
   if (!out) {
     throw std::runtime_error("figure: cannot write SVG '" + path +
                              "' — check that the folder exists and is writable");
   }
+  file.commit();
 }
 
 }  // namespace crevasse::analysis

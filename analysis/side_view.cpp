@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "analysis/damage_criterion.hpp"
+#include "engine/atomic_file.hpp"
 
 namespace crevasse::analysis {
 
@@ -361,11 +362,13 @@ SideViewImageSize write_side_view_png(const ParticleSnapshot& s, const std::file
   draw_axes(cr.get(), frame);
   if (o.show_title) draw_title_and_legend(cr.get(), o.width_px, s, o, marks);
 
-  const cairo_status_t status = cairo_surface_write_to_png(surface.get(), path.c_str());
+  AtomicFile file(path);
+  const cairo_status_t status = cairo_surface_write_to_png(surface.get(), file.temp_path().c_str());
   if (status != CAIRO_STATUS_SUCCESS) {
     throw std::runtime_error("side view: cannot write PNG '" + path.string() + "': " +
                              cairo_status_to_string(status) + " (does the directory exist?)");
   }
+  file.commit();
   return {o.width_px, static_cast<int>(height)};
 }
 

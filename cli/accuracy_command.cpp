@@ -122,10 +122,7 @@ std::vector<fs::path> accuracy_report(const AccuracyCommandOptions& opt, std::st
     if (!ref) throw InputError(opt.db_path + ": no finished case has a spacing to compare with");
   }
 
-  std::error_code ec;
-  fs::create_directories(opt.out_dir, ec);
-  if (ec || !fs::is_directory(opt.out_dir))
-    throw InputError("--out: cannot create directory " + opt.out_dir);
+  create_output_directory("--out", opt.out_dir);
   const fs::path csv_path = fs::path(opt.out_dir) / "accuracy_cost.csv";
   const fs::path md_path = fs::path(opt.out_dir) / "accuracy_cost.md";
   CsvFile csv(csv_path, "--out");
@@ -189,6 +186,8 @@ std::vector<fs::path> accuracy_report(const AccuracyCommandOptions& opt, std::st
 }
 
 int accuracy_command(const AccuracyCommandOptions& opt) {
+  check_output_directory("--out", opt.out_dir,
+                         {"accuracy_cost.csv", "accuracy_cost.md", "accuracy_cost.png", "accuracy_cost.svg"});
   std::string table;
   const auto files = accuracy_report(opt, &table);
   std::printf("%s", table.c_str());

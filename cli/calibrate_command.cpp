@@ -1,4 +1,5 @@
 #include "cli/calibrate_command.hpp"
+#include "cli/cli_common.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -154,11 +155,6 @@ void note_thickness(const StudyLaws& laws, double h) {
         short_number(h).c_str(), short_number(laws.thickness_min).c_str(), short_number(laws.thickness_max).c_str());
 }
 
-void check_level(double level) {
-  if (!(level > 0.5 && level < 1.0))
-    throw InputError("--level: " + short_number(level) + " is outside (0.5, 1)");
-}
-
 // The study's ice constants and the confidence level asked for.
 analysis::CalibrationOptions calibration_options(const StudyLaws& laws, double level) {
   analysis::CalibrationOptions options;
@@ -290,10 +286,11 @@ int calibrate_observations(const CalibrateCommandOptions& opt) {
 }  // namespace
 
 int calibrate_command(const CalibrateCommandOptions& opt) {
-  check_level(opt.level);
+  check_confidence_level(opt.level);
   if (!opt.observations_path.empty()) {
     if (opt.spacing_m != 0.0 || !opt.spacing_quartiles.empty() || opt.thickness_m)
       throw InputError("--observations: give either --observations or --spacing [--spacing-quartiles] [--thickness], not both");
+    if (!opt.csv_path.empty()) check_output_file("--csv", opt.csv_path);
     return calibrate_observations(opt);
   }
   if (!opt.csv_path.empty()) throw InputError("--csv: only with --observations");
@@ -377,7 +374,7 @@ int calibrate_command(const CalibrateCommandOptions& opt) {
 }
 
 int predict_command(const PredictCommandOptions& opt) {
-  check_level(opt.level);
+  check_confidence_level(opt.level);
   positive(opt.tensile_strength_pa, "--cohesion");
   positive(opt.thickness_m, "--thickness");
   const StudyLaws laws = load_laws(opt.db_path);

@@ -1,6 +1,10 @@
 #include "cli/cli_common.hpp"
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 
 #include "engine/error.hpp"
 
@@ -19,6 +23,45 @@ void create_output_directory(const std::string& option, const fs::path& dir) {
   if (ec || !fs::is_directory(dir))
     throw InputError(option + ": cannot create directory " + dir.string() +
                      (ec ? " (" + ec.message() + ")" : ""));
+}
+
+void check_output_directory(const std::string& option, const fs::path& dir,
+                            const std::vector<std::string>& files) {
+  std::error_code ec;
+  fs::path existing = fs::absolute(dir, ec);
+  if (ec) existing = dir;
+  const fs::path wanted = existing;
+  while (!fs::exists(fs::status(existing, ec)) && existing.has_relative_path())
+    existing = existing.parent_path();
+  if (!fs::is_directory(existing, ec))
+    throw InputError(option + ": " + existing.string() + " exists and is not a folder" +
+                     (existing == wanted ? std::string() : ", so " + dir.string() + " cannot be made"));
+  if (::access(existing.c_str(), W_OK | X_OK) != 0)
+    throw InputError(option + ": cannot write in " + existing.string() + " (" + std::strerror(errno) + ")");
+  for (const std::string& name : files) {  // a name ending in '/' is a folder
+    const fs::path p = dir / name;
+    if (!fs::exists(fs::symlink_status(p, ec))) continue;
+    const bool folder = !name.empty() && name.back() == '/';
+    if (folder ? !fs::is_directory(p, ec) : !fs::is_regular_file(p, ec))
+      throw InputError(option + ": " + p.string() + " is in the way (it exists and is not a " +
+                       (folder ? "folder" : "regular file") + ")");
+  }
+}
+
+void check_output_file(const std::string& option, const fs::path& file) {
+  std::error_code ec;
+  const fs::path parent = file.has_parent_path() ? file.parent_path() : fs::path(".");
+  check_output_directory(option, parent);
+  if (fs::exists(fs::symlink_status(file, ec)) && !fs::is_regular_file(fs::status(file, ec)))
+    throw InputError(option + ": " + file.string() + " exists and is not a regular file");
+}
+
+void check_confidence_level(double level) {
+  if (!(level > 0.5 && level < 1.0))
+    throw InputError("--level: " + format_number(level, "%.17g") + " is outside (0.5, 1)");
+  if (format_number(level, "%.4g") == "1")
+    throw InputError("--level: " + format_number(level, "%.17g") +
+                     " rounds to 1 (its intervals would be infinite); the largest is 0.9999");
 }
 
 std::vector<fs::path> write_png_and_svg(const analysis::Figure& figure, const fs::path& stem) {

@@ -19,6 +19,19 @@ std::string format_number(double v, const char* format = "%.3g");
 // cannot.
 void create_output_directory(const std::string& option, const std::filesystem::path& dir);
 
+// Output paths are checked before any work, as input paths are, so that a bad one costs no
+// simulation and leaves no partial output: `dir` must be a folder or not exist yet below a
+// folder this process may write to, and each of `files` (names inside it) must not exist as
+// anything but a regular file. InputError naming `option` and the path otherwise.
+void check_output_directory(const std::string& option, const std::filesystem::path& dir,
+                            const std::vector<std::string>& files = {});
+// The same for one output file: its folder as above, the file absent or a regular file.
+void check_output_file(const std::string& option, const std::filesystem::path& file);
+
+// --level of fit, calibrate and predict: in (0.5, 1), and below 1 as the tables show it (4
+// significant digits): a level that rounds to 1 has infinite intervals. InputError otherwise.
+void check_confidence_level(double level);
+
 // Writes `figure` as <stem>.png and <stem>.svg; returns the two paths, PNG first.
 std::vector<std::filesystem::path> write_png_and_svg(const analysis::Figure& figure,
                                                      const std::filesystem::path& stem);

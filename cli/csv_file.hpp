@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/atomic_file.hpp"
 #include "engine/error.hpp"
 
 namespace crevasse {
@@ -25,8 +26,10 @@ inline std::string csv_field(const std::string& v) {
 class CsvFile {
  public:
   // `option` names the command-line option the path came from, for messages.
+  // Written to a temporary file that close() renames over `path`: a kill or a full disk
+  // leaves the previous file or none, never a truncated one.
   CsvFile(const std::filesystem::path& path, std::string option = "--csv")
-      : path_(path), option_(std::move(option)), out_(path) {
+      : path_(path), option_(std::move(option)), file_(path), out_(file_.temp_path()) {
     if (!out_) throw InputError(option_ + ": cannot write " + path.string());
   }
   void row(const std::vector<std::string>& fields) {
@@ -37,11 +40,13 @@ class CsvFile {
     out_.close();
     if (!out_)
       throw std::runtime_error(option_ + ": writing " + path_.string() + " failed (disk full?)");
+    file_.commit();
   }
 
  private:
   std::filesystem::path path_;
   std::string option_;
+  AtomicFile file_;
   std::ofstream out_;
 };
 

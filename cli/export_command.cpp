@@ -103,6 +103,8 @@ void export_cases(sqlite3* db, const fs::path& path) {
 
 std::vector<fs::path> export_csv(const fs::path& db_path, const fs::path& dir) {
   Store store = Store::open_reader(db_path);
+  check_output_directory("--csv", dir, {"study.csv", "sessions.csv", "crevasses.csv", "summaries.csv",
+                                        "cases.csv", "fits.csv"});
   create_output_directory("--csv", dir);
   std::vector<fs::path> files;
   // One read transaction, so that the files agree with each other while a study is running.

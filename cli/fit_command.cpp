@@ -93,8 +93,7 @@ std::vector<const FitGroup*> varying_groups(const std::vector<CaseRecord>& cases
 }  // namespace
 
 int fit_command(const FitCommandOptions& opt) {
-  if (!(opt.level > 0.5 && opt.level < 1.0))
-    throw InputError("--level: " + std::to_string(opt.level) + " is outside (0.5, 1)");
+  check_confidence_level(opt.level);
   StudyFitOptions spacing_options, depth_options;
   spacing_options.level = depth_options.level = opt.level;
   spacing_options.exclude_fragmented = depth_options.exclude_fragmented = opt.exclude_fragmented;
@@ -161,19 +160,12 @@ int fit_command(const FitCommandOptions& opt) {
                      "); run crevasse fit again when the study has ended, or add --no-store");
   }
   Store& writer = *opened;
-  std::size_t rows = 0;
-  for (const auto& [group, records] : all) {
-    for (Quantity q : kQuantities) {
-      std::vector<FitRecord> mine;
-      for (const FitRecord& r : records)
-        if (r.quantity == quantity_key(q)) mine.push_back(r);
-      replace_fit_records(writer, quantity_key(q), group->name, mine);
-      rows += mine.size();
-    }
-  }
+  std::vector<FitRecord> rows;
+  for (const auto& [group, records] : all) rows.insert(rows.end(), records.begin(), records.end());
+  replace_fit_records(writer, rows);  // one transaction: never new spacing rows beside old depth rows
   writer.checkpoint();
   std::printf("\nstored %zu row(s) in table 'fits' of %s (sqlite3 %s \"SELECT * FROM fits\")\n",
-              rows, opt.db_path.c_str(), opt.db_path.c_str());
+              rows.size(), opt.db_path.c_str(), opt.db_path.c_str());
   return 0;
 }
 

@@ -1,12 +1,16 @@
 // The crevasse command line. Every error is caught here, printed on one line, and mapped to an
 // exit code: 2 for bad input, 1 for a failed simulation or any other error.
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <exception>
+#include <new>
 #include <optional>
 #include <string>
+#include <system_error>
 
 #include "cli/accuracy_command.hpp"
 #include "cli/calibrate_command.hpp"
@@ -62,7 +66,9 @@ std::string version_text() {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+namespace {
+
+int run_command_line(int argc, char** argv) {
   CLI::App app{"crevasse: scaling laws of glacier fracture from MPM parameter studies"};
   app.require_subcommand(1);
   app.set_version_flag("--version", version_text(),
@@ -198,9 +204,56 @@ int main(int argc, char** argv) {
   } catch (const crevasse::SimulationError& e) {
     std::fprintf(stderr, "crevasse: simulation failed: %s\n", one_line(e.what()).c_str());
     return 1;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "crevasse: error: out of memory; free memory or raise the limit (ulimit -v), "
+                         "then run the same command again\n");
+    return 1;
+  } catch (const std::system_error& e) {
+    std::fprintf(stderr, "crevasse: error: the system refused a resource (%s); free memory or raise "
+                         "the limits (ulimit -u, -v), then run the same command again\n",
+                 one_line(e.what()).c_str());
+    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "crevasse: error: %s\n", one_line(e.what()).c_str());
     return 1;
   }
   return 0;
+}
+
+// Output that never reached the user is an error: a full disk or a closed pipe behind stdout
+// (or stderr) turns an exit code 0 into 1.
+int check_streams(int code) {
+  errno = 0;
+  if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+    const int err = errno;
+    std::fprintf(stderr, "crevasse: error: writing to standard output failed (%s)\n",
+                 err ? std::strerror(err) : "write error");
+    if (code == 0) code = 1;
+  }
+  if (std::fflush(stderr) != 0 || std::ferror(stderr)) {
+    if (code == 0) code = 1;
+  }
+  return code;
+}
+
+// Memory set aside for running out of it: nlohmann::json's destructor allocates, so a failed
+// allocation while a case unwinds would end the process with SIGABRT, and closing the session
+// needs memory too. The first failed allocation frees the reserve and throws std::bad_alloc;
+// the unwinding then has room.
+char* g_memory_reserve = nullptr;
+
+void release_memory_reserve() {
+  if (!g_memory_reserve) throw std::bad_alloc();
+  delete[] g_memory_reserve;
+  g_memory_reserve = nullptr;
+  std::set_new_handler(nullptr);
+  throw std::bad_alloc();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  g_memory_reserve = new (std::nothrow) char[16u << 20];
+  if (g_memory_reserve) std::set_new_handler(release_memory_reserve);
+  return check_streams(run_command_line(argc, argv));
 }

@@ -80,6 +80,7 @@ std::vector<const CaseRecord*> default_cdf_cases(const std::vector<CaseRecord>& 
 }  // namespace
 
 std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
+  check_output_directory("--out", opt.out_dir);
   const FitGroup& group = find_fit_group(opt.group, "--group");
   const FitGroup& colour_by = find_fit_group(opt.colour_by, "--colour-by");
   if (opt.model != "auto" && opt.model != "single" && opt.model != "broken" && opt.model != "none")
@@ -113,6 +114,8 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
     added_names.push_back(study_name(other, path));
     added.push_back(read_case_records(other));
   }
+  // The fits table is read while drawing; an inconsistent row is refused here, before the folder.
+  for (Quantity q : kQuantities) read_fit_records(store, quantity_key(q), group.name);
   // Only once every input has been read: a refusal leaves no folder behind.
   create_output_directory("--out", opt.out_dir);
   std::vector<std::pair<const CaseRecord*, std::string>> drawn_cases;

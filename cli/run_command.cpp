@@ -1,4 +1,5 @@
 #include "cli/run_command.hpp"
+#include "cli/cli_common.hpp"
 
 #include <tbb/global_control.h>
 
@@ -91,6 +92,10 @@ int run_command(const RunCommandOptions& opt) {
   SceneConfig scene = load_scene_file(opt.scene_path);
   if (opt.vtu_interval >= 0) scene.vtu_interval = opt.vtu_interval;
   const fs::path out(opt.out_dir);
+  check_output_directory("--out", out,
+                         {"snapshots/", "scene_resolved.json", "run_summary.json", "crevasses.csv",
+                          "measurement.json", "measurements_over_time.csv", "side_view.png",
+                          "gate_view.png"});
   std::error_code ec;
   fs::create_directories(out / "snapshots", ec);
   if (ec)

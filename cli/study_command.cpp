@@ -94,6 +94,11 @@ class ConsoleObserver : public StudyObserver {
     if (!printer_is_tty_throttled(p)) printer_.update(line);
   }
 
+  void warn(const std::string& message) {
+    printer_.finish();
+    std::fprintf(stderr, "crevasse: warning: %s\n", message.c_str());
+  }
+
   void on_end(const RunnerReport& r) override {
     printer_.finish();
     std::fprintf(
@@ -140,6 +145,16 @@ int study_command(const StudyCommandOptions& opt) {
     return 0;
   }
 
+  if (!opt.views_dir.empty()) {
+    std::vector<std::string> views;
+    for (const StudyCase& c : study.cases) {
+      char stem[32];
+      std::snprintf(stem, sizeof stem, "case_%03zu_", c.index);
+      views.push_back(std::string(stem) + "side_view.png");
+      views.push_back(std::string(stem) + "gate_view.png");
+    }
+    check_output_directory("--views", opt.views_dir, views);
+  }
   std::string db = opt.db_path;
   if (db.empty()) {
     db = "results/" + study.name;
@@ -167,6 +182,8 @@ int study_command(const StudyCommandOptions& opt) {
   ro.command = opt.command_line;
   ro.views_dir = opt.views_dir;
   ro.observer = opt.quiet ? nullptr : &console;
+  // Shown even with --quiet: a warning says that work may have to be redone.
+  ro.warn = [&console](const std::string& m) { console.warn(m); };
   const InterruptHandlers handlers;
   ro.interrupt = &g_interrupt;
   const RunnerReport r = run_study(study, ro);

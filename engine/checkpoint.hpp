@@ -2,8 +2,9 @@
 // Binary checkpoints of a running simulation (docs/reliability.md, "Checkpoints"): everything
 // that the next step reads, so that a run restored from a checkpoint continues bit for bit as
 // the uninterrupted run would (same thread count not required: the step is deterministic).
-// The file starts with a magic string, the engine version and the canonical scene JSON; a
-// checkpoint of another scene or engine version is refused.
+// The file starts with a magic string, the engine version and the canonical scene JSON, and ends
+// with a checksum over everything between the magic strings; a checkpoint of another scene or
+// engine version, or one whose checksum does not match, is refused.
 #include <cstdint>
 #include <istream>
 #include <ostream>
@@ -26,12 +27,14 @@ struct RunCounters {
   std::int64_t inflow_columns = 0;
 };
 
-// Written atomically (temporary file, then rename); SimulationError when it cannot be.
+// Written atomically (temporary file, then rename); SimulationError when it cannot be, and then
+// no temporary file is left behind.
 template <int Dim>
 void save_checkpoint(const std::string& path, const SceneConfig& scene, const RunCounters& run,
                      const Particles<Dim>& particles, const GateRecorder<Dim>& gate);
-// Throws SimulationError when the file is not a checkpoint of this scene, dimension and engine
-// version, is truncated, or its arrays disagree with what `particles` holds (plastic state,
+// Throws SimulationError when the file is not a regular file (checked before it is opened, so a
+// FIFO never blocks), is not a checkpoint of this scene, dimension and engine version, is
+// truncated, fails its checksum, or its arrays disagree with what `particles` holds (plastic state,
 // piston layer, gate records); run, particles and gate change only when the whole file is good.
 template <int Dim>
 void load_checkpoint(const std::string& path, const SceneConfig& scene, RunCounters& run,
@@ -41,7 +44,12 @@ void load_checkpoint(const std::string& path, const SceneConfig& scene, RunCount
 
 namespace crevasse::checkpoint {
 
-inline constexpr char kMagic[8] = {'C', 'R', 'V', 'C', 'K', 'P', 'T', '1'};
+// Format 2 added the checksum.
+inline constexpr char kMagic[8] = {'C', 'R', 'V', 'C', 'K', 'P', 'T', '2'};
+
+// 64-bit FNV-1a over 8-byte words (then the tail bytes): cheap next to writing the file, and
+// any flipped bit changes it.
+std::uint64_t checksum(const char* data, std::size_t n);
 
 inline void write_bytes(std::ostream& o, const void* p, std::size_t n) {
   o.write(static_cast<const char*>(p), static_cast<std::streamsize>(n));
@@ -73,11 +81,12 @@ void put_vector(std::ostream& o, const std::vector<T>& v) {
   put(o, static_cast<std::uint64_t>(v.size()));
   if (!v.empty()) write_bytes(o, v.data(), v.size() * sizeof(T));
 }
+// max_bytes bounds the allocation by what the file can hold.
 template <class T>
-bool get_vector(std::istream& i, std::vector<T>& v, std::uint64_t max_size) {
+bool get_vector(std::istream& i, std::vector<T>& v, std::uint64_t max_bytes) {
   std::uint64_t n = 0;
   get(i, n);
-  if (!i || n > max_size) return false;
+  if (!i || n > max_bytes / sizeof(T)) return false;
   v.resize(n);
   if (n) read_bytes(i, v.data(), n * sizeof(T));
   return static_cast<bool>(i);

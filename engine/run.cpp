@@ -20,11 +20,41 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
   out.initial_mass = sim.total_mass();
   out.initial_particles = sim.particles().size();
   const std::string checkpoint = obs ? obs->checkpoint_path() : std::string();
-  if (!checkpoint.empty() && std::filesystem::exists(checkpoint)) {
-    sim.load_checkpoint(checkpoint);
-    out.resumed_from_time_s = sim.time();
+  std::error_code exists_ec;
+  // symlink_status: a dangling link or a FIFO is still "there" and must be dropped, not opened.
+  if (!checkpoint.empty() && std::filesystem::exists(std::filesystem::symlink_status(checkpoint, exists_ec))) {
+    try {
+      sim.load_checkpoint(checkpoint);  // changes nothing unless the whole file is good
+      out.resumed_from_time_s = sim.time();
+    } catch (const SimulationError& e) {
+      std::error_code ec;
+      std::filesystem::remove(checkpoint, ec);
+      obs->on_warning(std::string(e.what()) + "; " +
+                      (ec || std::filesystem::exists(std::filesystem::symlink_status(checkpoint, ec))
+                           ? "could not remove it; "
+                           : "removed it; ") +
+                      "the case runs from t = 0");
+    }
   }
   double last_checkpoint_wall = 0.0;
+  // A checkpoint that cannot be written costs only the time it would have saved.
+  auto save_checkpoint = [&] {
+    try {
+      sim.save_checkpoint(checkpoint);
+    } catch (const SimulationError& e) {
+      obs->on_warning(std::string(e.what()) + "; the case goes on without it");
+    }
+  };
+  const auto wall_now = [&] { return std::chrono::duration<double>(clock::now() - t0).count(); };
+  auto check_time_limit = [&](double wall, double done) {
+    if (scene.wall_time_limit > 0 && wall > scene.wall_time_limit) {
+      char msg[240];
+      std::snprintf(msg, sizeof msg, "time limit: run.wall_time_limit = %g s reached %s%.6g s, step %lld (%d%% done)",
+                    scene.wall_time_limit, sim.settled() ? "at t = " : "while settling, at settling time ",
+                    sim.time(), static_cast<long long>(sim.steps()), static_cast<int>(100 * done));
+      throw SimulationError(msg);
+    }
+  };
   // The front that counts is that of the connected ice, not of debris thrown ahead of it.
   double ice_front = sim.ice_front_x();
   const double front0 = ice_front;
@@ -63,6 +93,33 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
     stall.ramp_s = scene.drive_ramp_time;
   }
 
+  // The settling phase is polled between its steps like the run: time limit, checkpoints and
+  // cancellation, so that neither a signal nor the limit waits for it to end.
+  {
+    double last_poll = 0.0;
+    const bool settled = sim.settle([&] {
+      const double wall = wall_now();
+      check_time_limit(wall, 0.0);
+      if (!checkpoint.empty() && wall - last_checkpoint_wall >= obs->checkpoint_interval_s()) {
+        save_checkpoint();
+        last_checkpoint_wall = wall;
+      }
+      if (obs && wall - last_poll >= obs->progress_interval_s()) {
+        last_poll = wall;
+        if (obs->cancelled()) return false;
+      }
+      return true;
+    });
+    if (!settled) {
+      if (!checkpoint.empty()) save_checkpoint();
+      out.stop_reason = "cancelled";
+      out.steps = sim.steps();
+      out.sim_time_s = sim.time();
+      out.initial_mass = out.final_mass = sim.total_mass();
+      out.wall_s = wall_now();
+      return out;
+    }
+  }
   double last_report = 0.0;
   std::int64_t last_steps = 0, last_psteps = 0;
   while (true) {
@@ -81,16 +138,10 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
       obs->on_snapshot(sim.snapshot());
       while (next_snap <= sim.time() + 1e-12) next_snap += snap_interval;
     }
-    const double wall = std::chrono::duration<double>(clock::now() - t0).count();
-    if (scene.wall_time_limit > 0 && wall > scene.wall_time_limit) {
-      char msg[200];
-      std::snprintf(msg, sizeof msg, "time limit: run.wall_time_limit = %g s reached at t = %.6g s, step %lld (%d%% done)",
-                    scene.wall_time_limit, sim.time(), static_cast<long long>(sim.steps()),
-                    static_cast<int>(100 * fraction()));
-      throw SimulationError(msg);
-    }
+    const double wall = wall_now();
+    check_time_limit(wall, fraction());
     if (!checkpoint.empty() && wall - last_checkpoint_wall >= obs->checkpoint_interval_s()) {
-      sim.save_checkpoint(checkpoint);
+      save_checkpoint();
       last_checkpoint_wall = wall;
     }
     if (obs && wall - last_report >= obs->progress_interval_s()) {
@@ -111,7 +162,7 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
       last_steps = sim.steps();
       last_psteps = sim.particle_steps();
       if (obs->cancelled()) {
-        if (!checkpoint.empty()) sim.save_checkpoint(checkpoint);
+        if (!checkpoint.empty()) save_checkpoint();
         out.stop_reason = "cancelled";
         break;
       }

@@ -33,10 +33,15 @@ class RunObserver {
   virtual double snapshot_interval_s() const { return 0.0; }
   virtual void on_snapshot(const ParticleSnapshot&) {}
   // Checkpoints: when checkpoint_path() is not empty, the run continues from that file if it
-  // exists (a run killed earlier), writes it every checkpoint_interval_s() wall seconds and when
-  // cancelled, and deletes it when the run ends with a stop rule (Simulation::save_checkpoint).
+  // exists (a run killed earlier), writes it every checkpoint_interval_s() wall seconds, the
+  // settling phase included, and when cancelled, and deletes it when the run ends with a stop
+  // rule (Simulation::save_checkpoint). A checkpoint can only help: one that cannot be used
+  // (not a regular file, truncated, corrupt, of another scene or engine version) is reported
+  // through on_warning, removed, and the run starts from t = 0; a write that fails is reported
+  // and the run goes on.
   virtual std::string checkpoint_path() const { return {}; }
   virtual double checkpoint_interval_s() const { return 600.0; }
+  virtual void on_warning(const std::string& /*message*/) {}
   // Return true to stop the run early (cancellation); the run then ends with "cancelled".
   virtual bool cancelled() { return false; }
   // Wall seconds between on_progress calls.
@@ -86,7 +91,8 @@ struct RunSummary {
   ParticleSnapshot final_snapshot;
 };
 
-// Throws SimulationError on instability or when run.wall_time_limit is exceeded.
+// Throws SimulationError on instability or when run.wall_time_limit is exceeded (both checked
+// between steps, the settling phase included).
 RunSummary run_scene(const SceneConfig& scene, RunObserver* observer = nullptr);
 
 }  // namespace crevasse

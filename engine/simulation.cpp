@@ -186,13 +186,24 @@ void Simulation<Dim>::add_stage(std::string name, std::function<void()> run) {
 }
 
 template <int Dim>
-void Simulation<Dim>::settle() {
-  if (settled_) return;
-  settled_ = true;
-  if (scene_.settle_time <= 0.0) return;
+bool Simulation<Dim>::settle(const std::function<bool()>& keep_going) {
+  if (settled_) return true;
+  if (scene_.settle_time <= 0.0) {
+    settled_ = true;
+    return true;
+  }
+  // settled_ stays false until the phase ends, so that a checkpoint written while settling
+  // (between steps, through keep_going) resumes the phase where it stood.
   settling_ = true;
-  while (time_ < scene_.settle_time) step();
+  while (time_ < scene_.settle_time) {
+    step();
+    if (keep_going && !keep_going()) {
+      settling_ = false;
+      return false;
+    }
+  }
   settling_ = false;
+  settled_ = true;
   for (std::size_t p = 0; p < particles_.size(); ++p) {
     particles_.v[p].setZero();
     particles_.C[p].setZero();
@@ -204,6 +215,7 @@ void Simulation<Dim>::settle() {
   return_map_evaluations_ = 0;
   for (auto& st : stages_) st = {st.name, 0, 0.0};
   update_time_step();
+  return true;
 }
 
 template <int Dim>
@@ -218,7 +230,7 @@ void Simulation<Dim>::start_moving() {
 
 template <int Dim>
 void Simulation<Dim>::step() {
-  if (!settled_) settle();
+  if (!settled_ && !settling_) settle();
   for (std::size_t s = 0; s < stage_fns_.size(); ++s) {
     const auto t0 = std::chrono::steady_clock::now();
     stage_fns_[s].run();

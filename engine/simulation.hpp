@@ -40,7 +40,10 @@ class Simulation {
 
   void step();
   // Runs the settling phase (scene.settle_time) if it has not run yet; step() calls it first.
-  void settle();
+  // keep_going, when given, is asked after every settling step (the caller's stop flag, time
+  // limit and checkpoints); when it returns false the phase pauses and settle() returns false.
+  // The next settle() or step() continues it, as does a checkpoint written meanwhile.
+  bool settle(const std::function<bool()>& keep_going = {});
   bool settled() const { return settled_; }
 
   double time() const { return time_; }

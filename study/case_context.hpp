@@ -49,6 +49,12 @@ class CaseContext {
   }
   const std::filesystem::path& checkpoint_file() const { return checkpoint_file_; }
   double checkpoint_interval_s() const { return checkpoint_interval_s_; }
+  // Something the user should know that does not fail the case (a checkpoint that could not be
+  // written or used); the runner hands it to RunnerOptions::warn.
+  void set_warn(std::function<void(const std::string&)> warn) { warn_ = std::move(warn); }
+  void warn(const std::string& message) const {
+    if (warn_) warn_(message);
+  }
   // Where the case writes its side views (empty: none).
   void set_views_dir(std::filesystem::path dir) { views_dir_ = std::move(dir); }
   const std::filesystem::path& views_dir() const { return views_dir_; }
@@ -63,6 +69,7 @@ class CaseContext {
   std::filesystem::path checkpoint_file_;
   double checkpoint_interval_s_ = 0.0;
   std::filesystem::path views_dir_;
+  std::function<void(const std::string&)> warn_;
 };
 
 // Runs one case; throws (SimulationError, InputError, anything) to fail it.

@@ -80,6 +80,17 @@ std::vector<CaseRecord> read_case_records(Store& store) {
     r.failure_reason = s.text(k++);
     for (auto& g : r.groups) g = s.optional_real(k++);
     r.has_summary = s.integer(k++) != 0;
+    const std::string about = where + ": case " + r.label + " (" + r.case_id.substr(0, 12) + ")";
+    const std::string remedy =
+        ": the database is inconsistent (edited by hand or by another tool); set the case back "
+        "to pending (UPDATE cases SET status = 'pending' WHERE case_id = '" + r.case_id +
+        "') and run its study again, or restore the database";
+    if (r.status == "done" && !r.has_summary)
+      throw InputError(about + " is done but has no summaries row" + remedy);
+    for (int c = k; r.has_summary && c < k + 10; ++c)
+      if (!s.is_null(c) && !s.is_finite_number(c))
+        throw InputError(about + ": summaries." + s.column_name(c) + " holds '" + s.text(c) +
+                         "', not a finite number" + remedy);
     r.crevasse_count = s.integer(k++);
     r.spacing_count = s.integer(k++);
     r.no_crevasse = s.integer(k++) != 0;

@@ -22,6 +22,7 @@ class CaseObserver : public RunObserver {
   double progress_interval_s() const override { return 0.5; }
   std::string checkpoint_path() const override { return ctx_.checkpoint_file().string(); }
   double checkpoint_interval_s() const override { return ctx_.checkpoint_interval_s(); }
+  void on_warning(const std::string& message) override { ctx_.warn(message); }
 
  private:
   CaseContext& ctx_;

@@ -1,6 +1,10 @@
 #include "study/fits_table.hpp"
 
 #include <cmath>
+#include <set>
+#include <utility>
+
+#include "engine/error.hpp"
 
 namespace crevasse {
 namespace {
@@ -113,6 +117,37 @@ void set_comparison(FitRecord& r, const analysis::ModelComparison& c) {
   r.two_regimes = c.two_regimes_warranted;
 }
 
+// Deletes the rows of each (quantity, group_name) in `keys` and inserts `records`, in one
+// transaction, creating the table when absent.
+void replace_rows(Store& store, const std::set<std::pair<std::string, std::string>>& keys,
+                  const std::vector<FitRecord>& records) {
+  std::string marks;
+  for (int i = 0; i < kColumnCount; ++i) marks += i ? ", ?" : "?";
+  store.transaction([&] {
+    store.exec(kFitsSchema);
+    Statement del(store.handle(), "DELETE FROM fits WHERE quantity = ? AND group_name = ?");
+    for (const auto& [quantity, group_name] : keys) {
+      del.bind(1, quantity).bind(2, group_name);
+      del.run();
+    }
+    Statement ins(store.handle(),
+                  std::string("INSERT INTO fits (") + kColumns + ") VALUES (" + marks + ")");
+    for (const FitRecord& r : records) {
+      int k = 0;
+      for_each_field(r, [&](const auto& v) {
+        using T = std::decay_t<decltype(v)>;
+        if constexpr (std::is_same_v<T, bool>)
+          ins.bind(++k, static_cast<int>(v));
+        else if constexpr (std::is_same_v<T, std::optional<bool>>)
+          ins.bind(++k, v ? std::optional<int>(*v ? 1 : 0) : std::nullopt);
+        else
+          ins.bind(++k, v);
+      });
+      ins.run();
+    }
+  });
+}
+
 }  // namespace
 
 analysis::PowerLaw FitRecord::law() const {
@@ -202,29 +237,14 @@ std::vector<FitRecord> fit_records(const StudyFit& fit, const std::string& creat
 
 void replace_fit_records(Store& store, const std::string& quantity, const std::string& group_name,
                          const std::vector<FitRecord>& records) {
-  std::string marks;
-  for (int i = 0; i < kColumnCount; ++i) marks += i ? ", ?" : "?";
-  store.transaction([&] {
-    store.exec(kFitsSchema);
-    Statement del(store.handle(), "DELETE FROM fits WHERE quantity = ? AND group_name = ?");
-    del.bind(1, quantity).bind(2, group_name);
-    del.run();
-    Statement ins(store.handle(),
-                  std::string("INSERT INTO fits (") + kColumns + ") VALUES (" + marks + ")");
-    for (const FitRecord& r : records) {
-      int k = 0;
-      for_each_field(r, [&](const auto& v) {
-        using T = std::decay_t<decltype(v)>;
-        if constexpr (std::is_same_v<T, bool>)
-          ins.bind(++k, static_cast<int>(v));
-        else if constexpr (std::is_same_v<T, std::optional<bool>>)
-          ins.bind(++k, v ? std::optional<int>(*v ? 1 : 0) : std::nullopt);
-        else
-          ins.bind(++k, v);
-      });
-      ins.run();
-    }
-  });
+  // The pair is replaced even when `records` is empty.
+  replace_rows(store, {{quantity, group_name}}, records);
+}
+
+void replace_fit_records(Store& store, const std::vector<FitRecord>& records) {
+  std::set<std::pair<std::string, std::string>> keys;
+  for (const FitRecord& r : records) keys.emplace(r.quantity, r.group_name);
+  replace_rows(store, keys, records);
 }
 
 bool has_fits_table(Store& store) {
@@ -245,9 +265,12 @@ std::vector<FitRecord> read_fit_records(Store& store, const std::string& quantit
   while (s.step()) {
     FitRecord r;
     int k = 0;
+    int bad = -1;  // the first numeric column that holds no finite number
     for_each_field(r, [&](auto& v) {
       using T = std::decay_t<decltype(v)>;
       const int c = k++;
+      if constexpr (!std::is_same_v<T, std::string>)
+        if (bad < 0 && !s.is_null(c) && !s.is_finite_number(c)) bad = c;
       if constexpr (std::is_same_v<T, std::string>)
         v = s.text(c);
       else if constexpr (std::is_same_v<T, std::int64_t>)
@@ -261,6 +284,15 @@ std::vector<FitRecord> read_fit_records(Store& store, const std::string& quantit
       else
         v = s.optional_real(c);
     });
+    // A wrong number would be printed and used for predictions as if the fit had found it.
+    const bool level_ok = r.level > 0.5 && r.level < 1.0;
+    if (bad >= 0 || !level_ok)
+      throw InputError(store.path().string() + ": fits row (" + r.quantity + ", " + r.group_name + ", " +
+                       r.model + ", " + r.regime + "): " +
+                       (bad >= 0 ? "column " + std::string(s.column_name(bad)) + " holds '" + s.text(bad) +
+                                       "', not a finite number"
+                                 : "level " + s.text(8) + " is outside (0.5, 1)") +
+                       "; the table is inconsistent: run crevasse fit again to rewrite it");
     out.push_back(std::move(r));
   }
   return out;

@@ -53,6 +53,9 @@ std::vector<FitRecord> fit_records(const StudyFit& fit, const std::string& creat
 // table when absent.
 void replace_fit_records(Store& store, const std::string& quantity, const std::string& group_name,
                          const std::vector<FitRecord>& records);
+// Replaces the rows of every (quantity, group_name) that `records` holds, all in one
+// transaction: a fit killed midway leaves the old rows or all the new ones, never a mix.
+void replace_fit_records(Store& store, const std::vector<FitRecord>& records);
 
 // Whether `crevasse fit` has created the table (it is not part of the study schema).
 bool has_fits_table(Store& store);

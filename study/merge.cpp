@@ -1,9 +1,16 @@
 #include "study/merge.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <map>
 #include <optional>
 
+#include "engine/atomic_file.hpp"
 #include "engine/error.hpp"
 #include "study/store.hpp"
 
@@ -46,41 +53,8 @@ void copy_case(Store& store, const std::string& case_id) {
   p.run();
 }
 
-}  // namespace
-
-MergeReport merge_databases(const fs::path& out, const std::vector<fs::path>& inputs) {
-  if (inputs.empty()) throw InputError("merge: give at least one input database");
-  std::error_code ec;
-  for (const auto& in : inputs) {
-    if (fs::exists(out) && fs::equivalent(in, out, ec))
-      throw InputError("merge: input " + in.string() +
-                       " is the output database; give a new OUT path");
-  }
-  // Every input is checked before OUT is opened, so a refusal writes nothing: each exists, is a
-  // study database of this schema (the tables are copied column by column), and all hold one
-  // study, the one already in OUT if OUT exists.
-  std::optional<std::string> study;
-  std::string study_from;
-  const auto same_study = [&](const fs::path& db, bool output) {
-    Store reader = Store::open_reader(db);
-    if (reader.schema_version() != kStoreSchemaVersion)
-      throw InputError("merge: " + db.string() + " was written by an older crevasse (schema " +
-                       "version 1); resume its study once with this crevasse to upgrade it");
-    const std::optional<std::string> hash = reader.study_hash();
-    if (!hash) {
-      if (output) return;
-      throw InputError("merge: " + db.string() + ": holds no study (was it ever run?)");
-    }
-    if (study && *study != *hash)
-      throw InputError("merge: " + db.string() + " holds another study than " + study_from +
-                       " (other cases or engine version); merge only databases of one study");
-    study = hash;
-    study_from = db.string();
-  };
-  if (fs::exists(out, ec)) same_study(out, true);
-  for (const auto& in : inputs) same_study(in, false);
-  MergeReport report;
-  Store store = Store::open_writer(out, 10.0, "merge: OUT");
+// Merges each input into `store` (OUT, or the file that becomes OUT), one transaction per input.
+void merge_inputs(Store& store, const fs::path& out, const std::vector<fs::path>& inputs, MergeReport& report) {
   for (const auto& in : inputs) {
     {
       Statement a(store.handle(), "ATTACH DATABASE ? AS src");
@@ -152,7 +126,96 @@ MergeReport merge_databases(const fs::path& out, const std::vector<fs::path>& in
     store.exec("DETACH DATABASE src");
     ++report.inputs;
   }
-  store.checkpoint();
+}
+
+// Serialises the merges into one folder: held while a merge looks at OUT and writes it, so that
+// two merges into one new OUT never both decide to create it.
+class FolderLock {
+ public:
+  explicit FolderLock(const fs::path& dir) {
+    fd_ = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd_ < 0) throw InputError("merge: OUT: cannot open the folder " + dir.string() + " (" + std::strerror(errno) + ")");
+    while (::flock(fd_, LOCK_EX) != 0 && errno == EINTR) {
+    }
+  }
+  FolderLock(const FolderLock&) = delete;
+  FolderLock& operator=(const FolderLock&) = delete;
+  ~FolderLock() { ::close(fd_); }  // releases the flock
+
+ private:
+  int fd_ = -1;
+};
+
+}  // namespace
+
+MergeReport merge_databases(const fs::path& out, const std::vector<fs::path>& inputs) {
+  if (inputs.empty()) throw InputError("merge: give at least one input database");
+  std::error_code ec;
+  for (const auto& in : inputs) {
+    if (fs::exists(out) && fs::equivalent(in, out, ec))
+      throw InputError("merge: input " + in.string() +
+                       " is the output database; give a new OUT path");
+  }
+  // Every input is checked before OUT is opened, so a refusal writes nothing: each exists, is a
+  // study database of this schema (the tables are copied column by column), and all hold one
+  // study, the one already in OUT if OUT exists.
+  std::optional<std::string> study;
+  std::string study_from;
+  const auto same_study = [&](const fs::path& db, bool output) {
+    Store reader = Store::open_reader(db);
+    if (reader.schema_version() != kStoreSchemaVersion)
+      throw InputError("merge: " + db.string() + " was written by an older crevasse (schema " +
+                       "version 1); resume its study once with this crevasse to upgrade it");
+    const std::optional<std::string> hash = reader.study_hash();
+    if (!hash) {
+      if (output) return;
+      throw InputError("merge: " + db.string() + ": holds no study (was it ever run?)");
+    }
+    if (study && *study != *hash)
+      throw InputError("merge: " + db.string() + " holds another study than " + study_from +
+                       " (other cases or engine version); merge only databases of one study");
+    study = hash;
+    study_from = db.string();
+  };
+  for (const auto& in : inputs) same_study(in, false);
+  const fs::path folder = out.has_parent_path() ? out.parent_path() : fs::path(".");
+  fs::create_directories(folder, ec);
+  const FolderLock lock(folder);
+  MergeReport report;
+  // A new OUT (or the blank shell a killed merge or study left) is built beside it and renamed
+  // into place once whole: a kill or a full disk leaves no OUT, never a partial one.
+  const bool fresh = !fs::exists(fs::symlink_status(out, ec)) || Store::is_blank(out);
+  if (!fresh) {
+    same_study(out, true);
+    Store store = Store::open_writer(out, 10.0, "merge: OUT");
+    merge_inputs(store, out, inputs, report);
+    store.checkpoint();
+    return report;
+  }
+  AtomicFile file(out);
+  const auto remove_temp = [&] {
+    for (const char* suffix : {"-wal", "-shm", "-journal"}) fs::remove(file.temp_path().string() + suffix, ec);
+  };
+  try {
+    {
+      Store store = Store::open_writer(file.temp_path(), 10.0, "merge: OUT");
+      merge_inputs(store, out, inputs, report);
+      store.checkpoint();
+    }  // closed: the last connection folds the WAL into the file and removes it
+    remove_temp();
+    // A blank shell's WAL and shared memory belong to it, not to the new file.
+    for (const char* suffix : {"-wal", "-shm"}) fs::remove(out.string() + suffix, ec);
+    file.commit();
+  } catch (const std::runtime_error& e) {
+    remove_temp();
+    // The user named OUT, not the file that was to become it.
+    std::string message = e.what();
+    const std::string temp = file.temp_path().string();
+    for (std::size_t at = message.find(temp); at != std::string::npos; at = message.find(temp, at))
+      message.replace(at, temp.size(), out.string());
+    if (dynamic_cast<const InputError*>(&e)) throw InputError(message);
+    throw std::runtime_error(message);
+  }
   return report;
 }
 

@@ -23,6 +23,9 @@ namespace {
 
 using clock_type = std::chrono::steady_clock;
 
+// Next to the database, so that a resumed session finds it.
+std::filesystem::path checkpoint_dir(const std::filesystem::path& db) { return db.string() + ".checkpoints"; }
+
 double seconds_since(clock_type::time_point t0) {
   return std::chrono::duration<double>(clock_type::now() - t0).count();
 }
@@ -65,10 +68,11 @@ nlohmann::json deterministic_result(const CaseOutcome& o) {
 
 // What a worker hands to the writer (the calling thread).
 struct Event {
-  enum class Kind { started, finished, cancelled } kind;
+  enum class Kind { started, finished, cancelled, warning } kind;
   std::size_t slot = 0;  // index into the list of cases to run
   CaseResult result;     // finished only
   std::string started_at;
+  std::string message;  // warning only
 };
 
 class EventQueue {
@@ -169,6 +173,24 @@ class StudyRun {
 
   RunnerReport run() {
     set_up();
+    try {
+      return run_cases();
+    } catch (...) {
+      // Out of memory or threads, or a store that failed: the running cases go back to pending
+      // and the session is closed, so that the next session neither waits for nor reruns
+      // anything by mistake. Best effort: the store may be what failed.
+      stop().store(true);
+      try {
+        store_.reset_running();
+        store_.end_session(report_.session_id, "stopped", static_cast<std::int64_t>(report_.ran));
+      } catch (...) {
+      }
+      throw;
+    }
+  }
+
+ private:
+  RunnerReport run_cases() {
     const int jobs = std::max(
         1, std::min<int>(report_.jobs, static_cast<int>(std::max<std::size_t>(todo_.size(), 1))));
     // Workers: `jobs` loops, each taking the next case; each case runs in its own arena so that
@@ -183,22 +205,29 @@ class StudyRun {
     // queues, in an uninstrumented libtbb, are not). Each case still runs in its own task arena.
     std::exception_ptr worker_error;
     std::mutex worker_error_mutex;
+    auto keep_error = [&] {
+      const std::lock_guard<std::mutex> lock(worker_error_mutex);
+      if (!worker_error) worker_error = std::current_exception();
+      stop().store(true);
+    };
     std::thread executor([&] {
       std::vector<std::thread> workers;
-      for (int j = 0; j < jobs; ++j)
-        workers.emplace_back([&] {
-          try {
-            while (!stop().load()) {
-              const std::size_t slot = next_.fetch_add(1);
-              if (slot >= todo_.size()) return;
-              run_case(slot);
+      try {
+        for (int j = 0; j < jobs; ++j)
+          workers.emplace_back([&] {
+            try {
+              while (!stop().load()) {
+                const std::size_t slot = next_.fetch_add(1);
+                if (slot >= todo_.size()) return;
+                run_case(slot);
+              }
+            } catch (...) {
+              keep_error();
             }
-          } catch (...) {
-            const std::lock_guard<std::mutex> lock(worker_error_mutex);
-            if (!worker_error) worker_error = std::current_exception();
-            stop().store(true);
-          }
-        });
+          });
+      } catch (...) {  // a thread the system would not start ends the run like a worker's error
+        keep_error();
+      }
       for (auto& w : workers) w.join();
       queue_.close();
     });
@@ -209,7 +238,6 @@ class StudyRun {
     return finish();
   }
 
- private:
   std::atomic<bool>& stop() { return opt_.interrupt ? *opt_.interrupt : own_stop_; }
 
   void set_up() {
@@ -224,6 +252,15 @@ class StudyRun {
     case_function_ = opt_.case_function ? opt_.case_function : CaseFunction(run_engine_case);
 
     store_.init_study(study_);
+    if (study_.resources.checkpoint_interval_s > 0) {
+      const std::filesystem::path dir = checkpoint_dir(opt_.db_path);
+      std::error_code ec;
+      std::filesystem::create_directories(dir, ec);
+      if (ec || !std::filesystem::is_directory(dir))
+        throw InputError("resources.checkpoint_interval_s: cannot create the checkpoint folder " +
+                         dir.string() + (ec ? " (" + ec.message() + ")" : "") +
+                         "; remove what is in its place, or set checkpoint_interval_s to 0");
+    }
     const std::vector<const StudyCase*> scope =
         opt_.shard ? shard_cases(study_, *opt_.shard) : shard_cases(study_, Shard{0, 1});
     report_.in_scope = scope.size();
@@ -272,16 +309,12 @@ class StudyRun {
     if (exact_peak_rss_) reset_peak_rss();
     CaseContext ctx(threads, time_limit_, study_.measurement, stop(), fraction_[slot]);
     if (!opt_.views_dir.empty()) ctx.set_views_dir(opt_.views_dir);
+    ctx.set_warn([this, slot](const std::string& m) { queue_.push(Event{Event::Kind::warning, slot, {}, {}, m}); });
     std::filesystem::path checkpoint;
     if (study_.resources.checkpoint_interval_s > 0) {
-      // Next to the database: DB.checkpoints/CASE.ckpt (kept only while the case is unfinished).
-      const std::filesystem::path dir = opt_.db_path.string() + ".checkpoints";
-      std::error_code ec;
-      std::filesystem::create_directories(dir, ec);
-      if (!ec) {
-        checkpoint = dir / (c.case_id + ".ckpt");
-        ctx.set_checkpoint(checkpoint, study_.resources.checkpoint_interval_s);
-      }
+      // DB.checkpoints/CASE.ckpt, kept only while the case is unfinished (set_up made the folder).
+      checkpoint = checkpoint_dir(opt_.db_path) / (c.case_id + ".ckpt");
+      ctx.set_checkpoint(checkpoint, study_.resources.checkpoint_interval_s);
     }
     CaseOutcome outcome;
     std::string failure;
@@ -361,6 +394,9 @@ class StudyRun {
               eta.started(e.slot);
               --progress_.pending;
               break;
+            case Event::Kind::warning:
+              if (opt_.warn) opt_.warn(c.label + ": " + e.message);
+              break;
             case Event::Kind::cancelled:
               store_.mark_pending(c.case_id);
               eta.stopped(e.slot);
@@ -426,6 +462,19 @@ class StudyRun {
 
 }  // namespace
 
-RunnerReport run_study(const Study& study, const RunnerOptions& opt) { return StudyRun(study, opt).run(); }
+RunnerReport run_study(const Study& study, const RunnerOptions& opt) {
+  // Before the database is opened: a file where the checkpoint folder belongs would otherwise
+  // turn checkpointing off without a word, or be found only after hours of simulation.
+  if (study.resources.checkpoint_interval_s > 0) {
+    const std::filesystem::path dir = checkpoint_dir(opt.db_path);
+    std::error_code ec;
+    const auto st = std::filesystem::status(dir, ec);
+    if (std::filesystem::exists(st) && !std::filesystem::is_directory(st))
+      throw InputError("resources.checkpoint_interval_s: " + dir.string() +
+                       " must be a folder for the checkpoints but is a file; remove or rename it, "
+                       "or set checkpoint_interval_s to 0");
+  }
+  return StudyRun(study, opt).run();
+}
 
 }  // namespace crevasse

@@ -66,13 +66,17 @@ struct RunnerOptions {
   std::string command;         // recorded in the sessions table
   CaseFunction case_function;  // empty: run_engine_case (engine_case.hpp)
   StudyObserver* observer = nullptr;
+  // Warnings that do not fail a case (a checkpoint that could not be written or used), with
+  // the case's label; called on the calling thread. Empty: not shown.
+  std::function<void(const std::string&)> warn;
   std::filesystem::path views_dir;  // non-empty: each case writes its side views there
   // Set from outside (a signal handler) to end the session early: no new case starts, and the
   // running ones save a checkpoint and stay pending for the next session (report.interrupted).
   std::atomic<bool>* interrupt = nullptr;
 };
 
-// Throws InputError before anything runs when the database is unusable or holds another study.
+// Throws InputError before anything runs when the database is unusable or holds another study,
+// or when DB.checkpoints (needed when resources.checkpoint_interval_s > 0) is not a directory.
 RunnerReport run_study(const Study& study, const RunnerOptions& options);
 
 }  // namespace crevasse

@@ -7,6 +7,7 @@
 #include <cctype>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
@@ -193,6 +194,10 @@ std::int64_t Statement::integer(int c) const { return sqlite3_column_int64(stmt_
 std::optional<std::string> Statement::optional_text(int c) const {
   return is_null(c) ? std::nullopt : std::optional<std::string>(text(c));
 }
+bool Statement::is_finite_number(int c) const {
+  const int type = sqlite3_column_type(stmt_, c);
+  return (type == SQLITE_INTEGER || type == SQLITE_FLOAT) && std::isfinite(real(c));
+}
 std::optional<double> Statement::optional_real(int c) const {
   return is_null(c) ? std::nullopt : std::optional<double>(real(c));
 }
@@ -262,6 +267,14 @@ std::int64_t table_count(sqlite3* db) {
   return s.step() ? s.integer(0) : 0;
 }
 
+// Every schema version has these tables; another program's database, whatever its user_version,
+// lacks at least one.
+bool has_study_tables(sqlite3* db) {
+  Statement s(db, "SELECT count(*) FROM sqlite_master WHERE type = 'table' AND name IN "
+                  "('study', 'sessions', 'cases', 'crevasses', 'summaries')");
+  return s.step() && s.integer(0) == 5;
+}
+
 }  // namespace
 
 Store Store::open_writer(const fs::path& path, double wait_s, const std::string& option) {
@@ -323,8 +336,16 @@ Store Store::open_writer(const fs::path& path, double wait_s, const std::string&
   Store store(db, path, fd);
   sqlite3_busy_timeout(db, 10000);
   try {
-    const int version = read_user_version(db);
-    if (version == 0 && table_count(db) > 0)
+    // Decided on reads alone, before the WAL switch (which rewrites the header): a file that is
+    // not a study database stays as it was.
+    int version = 0;
+    try {
+      version = read_user_version(db);
+    } catch (const std::runtime_error& e) {
+      throw InputError(where + ": not an SQLite database, so not a crevasse study database (" + e.what() + ")");
+    }
+    const bool empty = table_count(db) == 0;
+    if (empty ? version != 0 : version == 0 || !has_study_tables(db))
       throw InputError(where +
                        ": this file is an SQLite database but not a crevasse study database");
     if (version > kStoreSchemaVersion)
@@ -349,8 +370,16 @@ Store Store::open_writer(const fs::path& path, double wait_s, const std::string&
       store.exec("PRAGMA user_version = " + std::to_string(kStoreSchemaVersion));
     });
   } catch (const std::runtime_error& e) {
-    if (dynamic_cast<const InputError*>(&e)) throw;
-    throw InputError(where + ": cannot write the database (" + e.what() + ")");
+    const std::string message = dynamic_cast<const InputError*>(&e)
+                                    ? std::string(e.what())
+                                    : where + ": cannot write the database (" + e.what() + ")";
+    if (created) {  // a database this call began (full disk, no file descriptors): none at all
+      sqlite3_close_v2(store.db_);
+      store.db_ = nullptr;
+      for (const char* suffix : {"-wal", "-shm", "-journal"}) fs::remove(path.string() + suffix, ec);
+      undo();  // still under the lock, which the store releases after
+    }
+    throw InputError(message);
   }
   return store;
 }
@@ -400,13 +429,32 @@ Store Store::open_reader(const fs::path& path) {
   try {
     version = read_user_version(db);
   } catch (const std::runtime_error& e) {
-    throw InputError(where + ": not a readable SQLite database (" + e.what() + ")");
+    throw InputError(where + ": not an SQLite database, so not a crevasse study database (" + e.what() + ")");
   }
+  if (version >= 1 && version <= kStoreSchemaVersion && !has_study_tables(db))
+    throw InputError(where + ": not a crevasse study database (it lacks a study's tables)");
   if (version < 1 || version > kStoreSchemaVersion)
     throw InputError(where + ": not a crevasse study database of schema version 1 to " +
                      std::to_string(kStoreSchemaVersion) + " (found " + std::to_string(version) +
                      ")");
   return store;
+}
+
+bool Store::is_blank(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return false;
+  if (fs::file_size(path, ec) == 0 && !ec) return true;
+  sqlite3* db = nullptr;
+  bool blank = false;
+  if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) == SQLITE_OK) {
+    try {
+      blank = read_user_version(db) == 0 && table_count(db) == 0;
+    } catch (const std::exception&) {
+      blank = false;  // not SQLite: not ours to replace
+    }
+  }
+  sqlite3_close_v2(db);
+  return blank;
 }
 
 int Store::schema_version() const { return read_user_version(db_); }

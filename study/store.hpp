@@ -54,6 +54,9 @@ class Statement {
   std::int64_t integer(int c) const;
   std::optional<std::string> optional_text(int c) const;
   std::optional<double> optional_real(int c) const;
+  // Whether column c holds a finite number (an INTEGER or REAL value): a TEXT or BLOB value, which
+  // real() would read as 0, or an infinity, is not data of a numeric column.
+  bool is_finite_number(int c) const;
 
  private:
   sqlite3* db_;
@@ -108,6 +111,9 @@ class Store {
   // Opens an existing database read-only. Throws InputError when it does not exist or is not a
   // crevasse study database.
   static Store open_reader(const std::filesystem::path& path);
+  // Whether `path` is an empty file or an SQLite database with no table and user_version 0: the
+  // shell a writer killed before it wrote the schema leaves, which holds nothing to keep.
+  static bool is_blank(const std::filesystem::path& path);
 
   Store(Store&& other) noexcept;
   Store& operator=(Store&&) = delete;

@@ -7,8 +7,13 @@
 #include <filesystem>
 #include <fstream>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <cstring>
+#include <iterator>
+
+#include "engine/checkpoint.hpp"
 #include "engine/error.hpp"
 #include "engine/run.hpp"
 #include "engine/simulation.hpp"
@@ -92,8 +97,73 @@ TEST(Checkpoint, OtherSceneAndTruncatedFilesAreRefused) {
     c.load_checkpoint(file.string());
     FAIL() << "a truncated checkpoint was loaded";
   } catch (const SimulationError& e) {
-    EXPECT_NE(std::string(e.what()).find("truncated or corrupt"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("truncated"), std::string::npos) << e.what();
   }
+  fs::remove(file);
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
+void spit(const fs::path& p, const std::string& bytes) {
+  std::ofstream(p, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+// The reason load_checkpoint gives for `file`, or "" when it loads.
+std::string refusal(const SceneConfig& scene, const fs::path& file) {
+  Simulation<2> sim(scene);
+  try {
+    sim.load_checkpoint(file.string());
+  } catch (const SimulationError& e) {
+    EXPECT_EQ(sim.time(), 0.0) << "a refused checkpoint changed the simulation";
+    return e.what();
+  }
+  return "";
+}
+
+// Every way a checkpoint can be unusable is refused with its reason: one flipped byte of the
+// state (the checksum), another engine version (with a valid checksum), the previous format,
+// an empty file, a directory and a FIFO (refused without being opened, so it cannot block).
+TEST(Checkpoint, CorruptForeignAndNonRegularFilesAreRefused) {
+  const SceneConfig scene = scene_from_json(test::shipped_scene_json());
+  const fs::path file = scratch("unusable");
+  Simulation<2> a(scene);
+  a.step();
+  a.save_checkpoint(file.string());
+  const std::string good = slurp(file);
+  ASSERT_EQ(refusal(scene, file), "");
+
+  std::string flipped = good;
+  flipped[good.size() / 2] ^= 0x10;  // inside the particle arrays
+  spit(file, flipped);
+  EXPECT_NE(refusal(scene, file).find("checksum"), std::string::npos) << refusal(scene, file);
+
+  // Another engine version, its checksum recomputed: refused for the version itself.
+  std::string other = good;
+  const std::size_t v = other.find(CREVASSE_ENGINE_VERSION);
+  ASSERT_NE(v, std::string::npos);
+  other[v] = other[v] == '9' ? '8' : '9';
+  const std::size_t payload = other.size() - 8 - 8 - 8;
+  const std::uint64_t sum = checkpoint::checksum(other.data() + 8, payload);
+  std::memcpy(other.data() + 8 + payload, &sum, sizeof sum);
+  spit(file, other);
+  EXPECT_NE(refusal(scene, file).find("another engine version"), std::string::npos) << refusal(scene, file);
+
+  std::string old_format = good;
+  old_format[7] = '1';
+  spit(file, old_format);
+  EXPECT_NE(refusal(scene, file).find("another checkpoint format"), std::string::npos);
+
+  spit(file, "");
+  EXPECT_NE(refusal(scene, file).find("truncated or empty"), std::string::npos);
+
+  fs::remove(file);
+  fs::create_directory(file);
+  EXPECT_NE(refusal(scene, file).find("not a regular file"), std::string::npos);
+  fs::remove(file);
+  ASSERT_EQ(::mkfifo(file.c_str(), 0600), 0);
+  EXPECT_NE(refusal(scene, file).find("not a regular file"), std::string::npos);
   fs::remove(file);
 }
 
@@ -105,13 +175,111 @@ class CheckpointingObserver : public RunObserver {
   double checkpoint_interval_s() const override { return 0.2; }
   double progress_interval_s() const override { return 0.3; }
   void on_progress(const RunProgress&) override { ++reports_; }
-  bool cancelled() override { return cancel_after_ > 0 && reports_ >= cancel_after_; }
+  bool cancelled() override { return cancel_now || (cancel_after_ > 0 && reports_ >= cancel_after_); }
+  bool cancel_now = false;
+  void on_warning(const std::string& m) override { warnings.push_back(m); }
+  std::vector<std::string> warnings;
 
  private:
   fs::path file_;
   int cancel_after_;
   int reports_ = 0;
 };
+
+// A checkpoint can only help: a run given an unusable checkpoint says so, removes it and runs
+// from t = 0 to the uninterrupted result; a run whose checkpoints cannot be written says so and
+// ends with the uninterrupted result, leaving no temporary file.
+TEST(Checkpoint, UnusableOrUnwritableCheckpointsCostNothing) {
+  nlohmann::json j = test::shipped_scene_json();
+  j["run"] = {{"max_steps", 400}};
+  const SceneConfig scene = scene_from_json(j);
+  const RunSummary whole = run_scene(scene);
+
+  const fs::path file = scratch("dropped");
+  for (const std::string bytes : {std::string(), std::string("CRVCKPT2 but nothing else"), std::string(5000, 'x')}) {
+    spit(file, bytes);
+    CheckpointingObserver obs(file, 0);
+    const RunSummary r = run_scene(scene, &obs);
+    EXPECT_EQ(r.resumed_from_time_s, -1.0);
+    EXPECT_EQ(r.steps, whole.steps);
+    expect_same_state(whole.final_snapshot, r.final_snapshot);
+    ASSERT_FALSE(obs.warnings.empty());
+    EXPECT_NE(obs.warnings[0].find("removed it; the case runs from t = 0"), std::string::npos) << obs.warnings[0];
+    EXPECT_FALSE(fs::exists(file));
+  }
+
+  // The folder does not exist: every write fails.
+  const fs::path nowhere = scratch("no_such_dir") / "c.ckpt";
+  struct SlowCheckpoints : CheckpointingObserver {
+    using CheckpointingObserver::CheckpointingObserver;
+    double checkpoint_interval_s() const override { return 0.0; }  // after every step
+  } obs(nowhere, 0);
+  const RunSummary r = run_scene(scene, &obs);
+  EXPECT_EQ(r.stop_reason, "max_steps");
+  expect_same_state(whole.final_snapshot, r.final_snapshot);
+  ASSERT_FALSE(obs.warnings.empty());
+  EXPECT_NE(obs.warnings[0].find("the case goes on without it"), std::string::npos) << obs.warnings[0];
+  EXPECT_FALSE(fs::exists(nowhere.string() + ".tmp"));
+}
+
+// The settling phase is a phase like the run: it pauses when asked, a checkpoint written while
+// settling continues bit for bit, run_scene stops it on cancellation with a checkpoint, and the
+// wall-time limit ends it.
+TEST(Checkpoint, SettlingPausesCheckpointsAndContinuesBitForBit) {
+  nlohmann::json j = test::shipped_scene_json();
+  j["ice"]["settle_time"] = 2.0;  // about 500 steps
+  j["run"] = {{"max_steps", 50}};
+  const SceneConfig scene = scene_from_json(j);
+  Simulation<2> a(scene);
+  a.settle();
+  while (a.steps() < 50) a.step();
+
+  const fs::path file = scratch("settling");
+  Simulation<2> b(scene);
+  int steps = 0;
+  EXPECT_FALSE(b.settle([&] { return ++steps < 120; }));
+  EXPECT_FALSE(b.settled());
+  EXPECT_GT(b.time(), 0.0);
+  b.save_checkpoint(file.string());
+  Simulation<2> c(scene);
+  c.load_checkpoint(file.string());
+  EXPECT_FALSE(c.settled());
+  EXPECT_TRUE(c.settle());
+  while (c.steps() < 50) c.step();
+  expect_same_state(a.snapshot(), c.snapshot());
+
+  // run_scene: cancelled while settling (the observer's first poll), with a checkpoint to go on from.
+  fs::remove(file);
+  struct Stopper : CheckpointingObserver {
+    using CheckpointingObserver::CheckpointingObserver;
+    double progress_interval_s() const override { return 0.0; }  // asked after every step
+  } stopper(file, 0);
+  stopper.cancel_now = true;
+  const RunSummary first = run_scene(scene, &stopper);
+  EXPECT_EQ(first.stop_reason, "cancelled");
+  EXPECT_GT(first.sim_time_s, 0.0);
+  EXPECT_LT(first.sim_time_s, 2.0) << "stopped only after settling";
+  ASSERT_TRUE(fs::exists(file));
+  Simulation<2> probe(scene);
+  probe.load_checkpoint(file.string());
+  EXPECT_FALSE(probe.settled()) << "the run was stopped only after settling";
+  CheckpointingObserver resume(file, 0);
+  const RunSummary second = run_scene(scene, &resume);
+  EXPECT_EQ(second.resumed_from_time_s, first.sim_time_s);
+  expect_same_state(a.snapshot(), second.final_snapshot);
+  fs::remove(file);
+
+  // The wall-time limit ends a long settling phase, not its end.
+  nlohmann::json long_settle = j;
+  long_settle["ice"]["settle_time"] = 300.0;  // about 70,000 steps, many seconds
+  long_settle["run"]["wall_time_limit"] = 0.5;
+  try {
+    run_scene(scene_from_json(long_settle));
+    FAIL() << "the time limit did not fire";
+  } catch (const SimulationError& e) {
+    EXPECT_NE(std::string(e.what()).find("while settling"), std::string::npos) << e.what();
+  }
+}
 
 TEST(Checkpoint, CancelledRunResumesToTheUninterruptedResult) {
   nlohmann::json j = test::shipped_scene_json();
