@@ -119,6 +119,24 @@ TEST(FlowingGlacier, NothingDownstreamCarriesThePushedGlacier) {
   EXPECT_GT(held_end, 1e-3) << "held nodes must fail the bound, else it measures nothing";
 }
 
+// The passed frame's window ends at the front of the ice that started upstream of the top of the
+// step (docs/measurement.md): at the start that ice ends at the lip, and the drive carries it on
+// at about V_x, while the ice draped past the lip lies ahead of it.
+TEST(FlowingGlacier, UpstreamIceFrontFollowsTheIceThatStartedBeforeTheLip) {
+  const SceneConfig scene = scene_from_json(test::shipped_scene_json("pushed_2d.json"));
+  Simulation<2> sim(scene);
+  sim.settle();
+  const double top = scene.step_top_x();
+  const ParticleSnapshot start = sim.snapshot();
+  EXPECT_GT(start.front_x(), top + scene.ice_thickness);  // draped ice ahead of it
+  EXPECT_LE(start.upstream_ice_front_x_m, top);
+  EXPECT_GE(start.upstream_ice_front_x_m, top - scene.dx);
+  const double t0 = sim.time();
+  while (sim.time() < t0 + 10.0) sim.step();
+  const double moved = sim.snapshot().upstream_ice_front_x_m - start.upstream_ice_front_x_m;
+  EXPECT_NEAR(moved, scene.drive_speed * 10.0, 0.5 * scene.drive_speed * 10.0);
+}
+
 // "hydrostatic" loads the cryostatic state σ = −ρ g (s − z) I: no deviatoric stress at rest, so a
 // shear strength below the K0 state's q = (1 − 2ν)/(1 − ν)·ρ g (s − z) does not yield at t = 0.
 TEST(FlowingGlacier, HydrostaticStartHasNoDeviatoricStress) {
