@@ -22,6 +22,7 @@
 #include "cli/study_command.hpp"
 #include "engine/error.hpp"
 #include "study/json_checks.hpp"
+#include "study/memory_reserve.hpp"
 #include "study/merge.hpp"
 
 namespace {
@@ -205,6 +206,7 @@ int run_command_line(int argc, char** argv) {
     std::fprintf(stderr, "crevasse: simulation failed: %s\n", one_line(e.what()).c_str());
     return 1;
   } catch (const std::bad_alloc&) {
+    crevasse::rearm_memory_reserve();
     std::fprintf(stderr, "crevasse: error: out of memory; free memory or raise the limit (ulimit -v), "
                          "then run the same command again\n");
     return 1;
@@ -236,24 +238,9 @@ int check_streams(int code) {
   return code;
 }
 
-// Memory set aside for running out of it: nlohmann::json's destructor allocates, so a failed
-// allocation while a case unwinds would end the process with SIGABRT, and closing the session
-// needs memory too. The first failed allocation frees the reserve and throws std::bad_alloc;
-// the unwinding then has room.
-char* g_memory_reserve = nullptr;
-
-void release_memory_reserve() {
-  if (!g_memory_reserve) throw std::bad_alloc();
-  delete[] g_memory_reserve;
-  g_memory_reserve = nullptr;
-  std::set_new_handler(nullptr);
-  throw std::bad_alloc();
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
-  g_memory_reserve = new (std::nothrow) char[16u << 20];
-  if (g_memory_reserve) std::set_new_handler(release_memory_reserve);
+  crevasse::arm_memory_reserve(16u << 20);
   return check_streams(run_command_line(argc, argv));
 }

@@ -4,12 +4,14 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <new>
 #include <stdexcept>
 
 #include "analysis/measurement_io.hpp"
 #include "engine/error.hpp"
 #include "engine/run.hpp"
 #include "study/case_views.hpp"
+#include "study/memory_reserve.hpp"
 
 namespace crevasse {
 namespace {
@@ -18,7 +20,11 @@ class CaseObserver : public RunObserver {
  public:
   explicit CaseObserver(CaseContext& ctx) : ctx_(ctx) {}
   void on_progress(const RunProgress& p) override { ctx_.report_fraction(p.fraction_done); }
-  bool cancelled() override { return ctx_.should_stop(); }
+  bool cancelled() override {
+    // A safe place to fail when an allocation had to take the memory reserve.
+    if (memory_ran_out()) throw std::bad_alloc();
+    return ctx_.should_stop();
+  }
   double progress_interval_s() const override { return 0.5; }
   std::string checkpoint_path() const override { return ctx_.checkpoint_file().string(); }
   double checkpoint_interval_s() const override { return ctx_.checkpoint_interval_s(); }

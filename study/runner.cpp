@@ -17,6 +17,7 @@
 #include "analysis/measurement_io.hpp"
 #include "engine/error.hpp"
 #include "study/engine_case.hpp"
+#include "study/memory_reserve.hpp"
 
 namespace crevasse {
 namespace {
@@ -307,6 +308,7 @@ class StudyRun {
     const std::string started_at = started.started_at;
     queue_.push(std::move(started));
     if (exact_peak_rss_) reset_peak_rss();
+    rearm_memory_reserve();  // in case an earlier failure could not take it back
     CaseContext ctx(threads, time_limit_, study_.measurement, stop(), fraction_[slot]);
     if (!opt_.views_dir.empty()) ctx.set_views_dir(opt_.views_dir);
     ctx.set_warn([this, slot](const std::string& m) { queue_.push(Event{Event::Kind::warning, slot, {}, {}, m}); });
@@ -321,6 +323,7 @@ class StudyRun {
     try {
       tbb::task_arena arena(threads);
       arena.execute([&] { outcome = case_function_(c, ctx); });
+      if (memory_ran_out()) throw std::bad_alloc();  // the reserve got the case through: still a failure
     } catch (const SimulationError& e) {
       failure = e.what();
     } catch (const InputError& e) {
@@ -332,6 +335,9 @@ class StudyRun {
     } catch (...) {
       failure = "unknown exception";
     }
+    // The case's memory is freed by now: after running out, take the reserve back and let the
+    // other cases go on.
+    if (!failure.empty()) rearm_memory_reserve();
     if (failure.empty() && outcome.cancelled) {
       if (!ctx.time_limit_exceeded()) {
         queue_.push(Event{Event::Kind::cancelled, slot, {}, started_at});
