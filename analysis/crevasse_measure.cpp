@@ -283,6 +283,10 @@ CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
     if (!window_has_length || !in_window(px[p])) continue;
     ++m.window_particle_count;
     window_damaged += damaged[p];
+    if (m.surface.height_at(px[p]) - pz[p] > 0.5 * r.ice_thickness_m) {
+      ++m.deep_particle_count;
+      m.deep_damaged_count += damaged[p];
+    }
     const auto b = std::min(
         m.surface.size() - 1,
         static_cast<std::size_t>(std::max(0.0, std::floor((px[p] - m.surface.x0_m) / r.dx_m))));
@@ -290,6 +294,7 @@ CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
     if (!damaged[p]) bin_has_intact[b] = 1;
   }
   m.flags.empty_window = m.window_particle_count == 0;
+  m.window_damaged_count = window_damaged;
   if (!m.flags.empty_window) {
     const auto occupied = std::count(bin_has_any.begin(), bin_has_any.end(), 1);
     const auto broken = occupied - std::count(bin_has_intact.begin(), bin_has_intact.end(), 1);

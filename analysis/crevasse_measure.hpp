@@ -144,6 +144,13 @@ struct CrevasseMeasurement {
   std::size_t window_particle_count = 0;
   std::size_t damaged_particle_count = 0;  // of the measured particles
   std::size_t cluster_count = 0;           // damaged clusters anywhere, crevasse or not
+  // How broken the window's ice is: the damaged share of its particles, and of those lying more
+  // than H_i/2 below the local surface. Surface crevasses of partial depth leave the second
+  // near zero; ice shattered under its surface (or cut through by many full-depth fractures)
+  // does not. Not a flag: no threshold is part of the measurement.
+  std::size_t window_damaged_count = 0;
+  std::size_t deep_particle_count = 0;
+  std::size_t deep_damaged_count = 0;
   // Statistics are absent (not NaN) when there is nothing to summarise.
   std::optional<QuartileSummary> spacing_m, spacing_over_h;
   std::optional<QuartileSummary> depth_m, depth_over_h;

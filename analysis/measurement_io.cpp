@@ -80,6 +80,14 @@ nlohmann::json settings_to_json(const ResolvedMeasureSettings& s) {
   return j;
 }
 
+namespace {
+// A share, or null when there is nothing to take it of.
+nlohmann::json share(std::size_t part, std::size_t whole) {
+  if (whole == 0) return nullptr;
+  return static_cast<double>(part) / static_cast<double>(whole);
+}
+}  // namespace
+
 nlohmann::json measurement_summary_json(const CrevasseMeasurement& m) {
   nlohmann::json positions = nlohmann::json::array(), depths = nlohmann::json::array(),
                  widths = nlohmann::json::array();
@@ -109,6 +117,12 @@ nlohmann::json measurement_summary_json(const CrevasseMeasurement& m) {
         {"window_particles", m.window_particle_count},
         {"damaged_particles", m.damaged_particle_count},
         {"damage_clusters", m.cluster_count}}},
+      {"damage",
+       {{"window_damaged_particles", m.window_damaged_count},
+        {"deep_particles", m.deep_particle_count},
+        {"deep_damaged_particles", m.deep_damaged_count},
+        {"window_damaged_fraction", share(m.window_damaged_count, m.window_particle_count)},
+        {"deep_damaged_fraction", share(m.deep_damaged_count, m.deep_particle_count)}}},
       {"positions_m", positions},
       {"depths_m", depths},
       {"widths_m", widths},

@@ -554,5 +554,37 @@ TEST(MeasureWriters, UnwritablePathThrowsWithThePath) {
   }
 }
 
+
+// How broken the window is, on a constructed field (H_i = 100 m, particles 5 m apart, window
+// [0, 2000] m: 400 columns of 20 particles, 10 of them more than H_i/2 below the surface).
+// A partial-depth surface crevasse 30 m deep and 6 columns wide leaves the deep share at zero;
+// a buried band from 60 m below the surface to the bed, 40 columns wide, damages 8 of the 10
+// deep rows there: 320 of the window's 4000 deep particles.
+TEST(MeasureDamage, DeepShareSeesIceBrokenUnderItsSurfaceOnly) {
+  SlabSpec spec;
+  MeasureSettings whole;
+  whole.frame = "final";
+  whole.window_min_x_m = 0.0;
+  whole.window_max_x_m = 2000.0;
+  const CrevasseMeasurement surface_only =
+      measure_crevasses(make_slab(spec, {{.x_m = 500.0, .depth_m = 30.0, .width_m = 30.0}}), whole);
+  ASSERT_EQ(surface_only.crevasses.size(), 1u);
+  EXPECT_EQ(surface_only.window_particle_count, 8000u);
+  EXPECT_EQ(surface_only.window_damaged_count, 6u * 6u);
+  EXPECT_EQ(surface_only.deep_particle_count, 4000u);
+  EXPECT_EQ(surface_only.deep_damaged_count, 0u);
+
+  const CrevasseMeasurement buried = measure_crevasses(
+      make_slab(spec, {{.x_m = 500.0, .depth_m = 30.0, .width_m = 30.0},
+                       {.x_m = 1200.0, .depth_m = 100.0, .width_m = 200.0, .top_gap_m = 60.0}}),
+      whole);
+  EXPECT_EQ(buried.crevasses.size(), 1u) << "buried damage is not a crevasse";
+  EXPECT_EQ(buried.deep_particle_count, 4000u);
+  EXPECT_EQ(buried.deep_damaged_count, 320u);
+  const nlohmann::json j = measurement_summary_json(buried);
+  EXPECT_DOUBLE_EQ(j["damage"]["deep_damaged_fraction"].get<double>(), 0.08);
+  EXPECT_DOUBLE_EQ(j["damage"]["window_damaged_fraction"].get<double>(), (36.0 + 320.0) / 8000.0);
+}
+
 }  // namespace
 }  // namespace crevasse::analysis
