@@ -83,8 +83,10 @@ int status_command(const StatusCommandOptions& opt) {
   }
   if (c.done > 0) {
     const long long limit = opt.all_cases ? -1 : kDefaultCaseRows;
-    std::printf("done:\n  %5s  %-10s %8s %8s %8s %7s  %5s %9s %9s %8s  %s\n", "index", "case",
-                "H_i[m]", "Pi", "r=Ls/Hi", "S", "crev", "Lp/Hi", "Dp/Hi", "wall", "label");
+    // deep = the damaged share of the window's ice more than H_i/2 below its surface
+    // (docs/measurement.md): shattering under an intact surface shows there.
+    std::printf("done:\n  %5s  %-10s %8s %8s %8s %7s  %5s %9s %9s %5s %8s  %s\n", "index", "case",
+                "H_i[m]", "Pi", "r=Ls/Hi", "S", "crev", "Lp/Hi", "Dp/Hi", "deep", "wall", "label");
     Statement s(
         db,
         "SELECT c.case_index, substr(c.case_id, 1, 10), c.thickness_m, c.cohesion_ratio, "
@@ -93,16 +95,18 @@ int status_command(const StatusCommandOptions& opt) {
         "c.label, "
         "m.fragmented, " +
             store.under_resolved_column() +
+            ", 100.0 * json_extract(c.result_json, '$.measurement.damage.deep_damaged_fraction')"
             " FROM cases c LEFT JOIN summaries m USING (case_id) WHERE c.status = 'done' "
             "ORDER BY c.case_index LIMIT ?");
     s.bind(1, static_cast<std::int64_t>(limit));
     while (s.step()) {
-      std::printf("  %5lld  %-10s %8s %8s %8s %7s  %5lld %9s %9s %8s  %s%s%s\n",
+      std::printf("  %5lld  %-10s %8s %8s %8s %7s  %5lld %9s %9s %5s %8s  %s%s%s\n",
                   static_cast<long long>(s.integer(0)), s.text(1).c_str(),
                   cell(s, 2, "%.0f").c_str(), cell(s, 3, "%.4g").c_str(),
                   cell(s, 4, "%.3g").c_str(), cell(s, 5, "%.3g").c_str(),
                   static_cast<long long>(s.integer(6)), cell(s, 7, "%.3f").c_str(),
-                  cell(s, 8, "%.3f").c_str(), format_wall_time(s.real(9)).c_str(),
+                  cell(s, 8, "%.3f").c_str(), cell(s, 13, "%.0f%%").c_str(),
+                  format_wall_time(s.real(9)).c_str(),
                   s.text(10).c_str(),
                   s.integer(11) ? "  (fragmented)" : "",
                   s.integer(12) ? "  (under-resolved: c/(rho_i g) < 3 dx)" : "");
