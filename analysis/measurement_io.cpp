@@ -2,30 +2,33 @@
 
 #include <cerrno>
 #include <cstring>
-#include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <string>
+
+#include "engine/atomic_file.hpp"
 
 namespace crevasse::analysis {
 
 namespace {
 
-std::ofstream open_for_writing(const std::filesystem::path& path, const char* what) {
-  std::ofstream out(path);
-  if (!out) {
-    throw std::runtime_error(std::string("cannot write ") + what + " to '" + path.string() +
-                             "': " + std::strerror(errno) + " (does the directory exist?)");
-  }
+// Built in memory, then written whole or not at all (engine/atomic_file.hpp).
+std::ostringstream open_for_writing() {
+  std::ostringstream out;
   // 10 significant digits: sub-millimetre at glacier scales, and stable across platforms.
   out.precision(10);
   return out;
 }
 
-void finish(std::ofstream& out, const std::filesystem::path& path, const char* what) {
-  out.flush();
-  if (!out) {
-    throw std::runtime_error(std::string("writing ") + what + " to '" + path.string() +
-                             "' failed (disk full?)");
+void finish(const std::ostringstream& out, const std::filesystem::path& path, const char* what) {
+  const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : ".";
+  if (!std::filesystem::is_directory(dir))
+    throw std::runtime_error(std::string("cannot write ") + what + " to '" + path.string() +
+                             "': no such directory (does the directory exist?)");
+  try {
+    write_file_atomically(path, out.str());
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(std::string("writing ") + what + " to '" + path.string() + "' failed: " + e.what());
   }
 }
 
@@ -37,7 +40,7 @@ nlohmann::json quartiles_json(const std::optional<QuartileSummary>& q) {
 }  // namespace
 
 void write_crevasses_csv(const CrevasseMeasurement& m, const std::filesystem::path& path) {
-  std::ofstream out = open_for_writing(path, "crevasses CSV");
+  std::ostringstream out = open_for_writing();
   out << "index,x_m,depth_m,width_m,depth_over_H,spacing_to_next_m\n";
   const double h = m.settings.ice_thickness_m;
   for (std::size_t i = 0; i < m.crevasses.size(); ++i) {
@@ -132,7 +135,7 @@ nlohmann::json measurement_summary_json(const CrevasseMeasurement& m) {
 }
 
 void write_measurement_summary(const CrevasseMeasurement& m, const std::filesystem::path& path) {
-  std::ofstream out = open_for_writing(path, "measurement summary JSON");
+  std::ostringstream out = open_for_writing();
   out << measurement_summary_json(m).dump(2) << '\n';
   finish(out, path, "measurement summary JSON");
 }

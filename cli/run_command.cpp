@@ -12,6 +12,7 @@
 #include "analysis/crevasse_measure.hpp"
 #include "analysis/measurement_io.hpp"
 #include "cli/progress_printer.hpp"
+#include "engine/atomic_file.hpp"
 #include "engine/error.hpp"
 #include "engine/run.hpp"
 #include "engine/vtu_writer.hpp"
@@ -100,10 +101,7 @@ int run_command(const RunCommandOptions& opt) {
   fs::create_directories(out / "snapshots", ec);
   if (ec)
     throw InputError("--out: cannot create directory " + out.string() + " (" + ec.message() + ")");
-  {
-    std::ofstream f(out / "scene_resolved.json");
-    f << scene_to_json(scene).dump(2) << "\n";
-  }
+  write_file_atomically(out / "scene_resolved.json", scene_to_json(scene).dump(2) + "\n");
   std::unique_ptr<tbb::global_control> threads;
   if (opt.threads > 0)
     threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
@@ -132,7 +130,7 @@ int run_command(const RunCommandOptions& opt) {
       {"stage_seconds", r.stage_seconds},
       {"engine_version", CREVASSE_ENGINE_VERSION},
   };
-  std::ofstream(out / "run_summary.json") << summary.dump(2) << "\n";
+  write_file_atomically(out / "run_summary.json", summary.dump(2) + "\n");
 
   // Crevasses at the end of the run (in the gate frame when the scene records one;
   // docs/measurement.md), and the side views with each one marked.

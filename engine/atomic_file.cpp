@@ -4,6 +4,8 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstring>
+#include <fstream>
 #include <stdexcept>
 #include <string>
 
@@ -38,6 +40,18 @@ void AtomicFile::commit() {
     throw std::runtime_error("cannot rename " + temp_.string() + " to " + target_.string() + " (" +
                              ec.message() + ")");
   committed_ = true;
+}
+
+void write_file_atomically(const std::filesystem::path& target, const std::string& content) {
+  AtomicFile file(target);
+  {
+    std::ofstream f(file.temp_path(), std::ios::binary | std::ios::trunc);
+    if (!f) throw std::runtime_error("cannot write " + target.string() + ": " + std::strerror(errno));
+    f.write(content.data(), static_cast<std::streamsize>(content.size()));
+    f.close();
+    if (!f) throw std::runtime_error("writing " + target.string() + " failed (disk full?)");
+  }
+  file.commit();
 }
 
 }  // namespace crevasse

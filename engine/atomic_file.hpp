@@ -3,6 +3,7 @@
 // renames it over the target only once it is complete, so a kill, a full disk or an error
 // midway leaves the previous file (or none), never a truncated one.
 #include <filesystem>
+#include <string>
 
 namespace crevasse {
 
@@ -24,5 +25,9 @@ class AtomicFile {
   std::filesystem::path target_, temp_;
   bool committed_ = false;
 };
+
+// Writes `content` to `target` through an AtomicFile; std::runtime_error naming the file when
+// it cannot be written whole (a full disk, a size limit).
+void write_file_atomically(const std::filesystem::path& target, const std::string& content);
 
 }  // namespace crevasse

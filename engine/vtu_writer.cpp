@@ -2,7 +2,10 @@
 
 #include <cstdint>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
+
+#include "engine/atomic_file.hpp"
 
 namespace crevasse {
 namespace {
@@ -39,7 +42,8 @@ void write_vtu(const std::string& path, const ParticleSnapshot& s) {
   point_data.push_back({"sigma_zz", 1, s.sigma_zz_pa});
   point_data.push_back({"volume", 1, s.volume_m3});
 
-  std::ofstream f(path, std::ios::binary);
+  AtomicFile file(path);  // ParaView never sees half a snapshot
+  std::ofstream f(file.temp_path(), std::ios::binary);
   if (!f) throw std::runtime_error("cannot write " + path);
   std::uint64_t offset = 0;
   auto block_bytes = [](std::size_t count, std::size_t size) { return sizeof(std::uint64_t) + count * size; };
@@ -80,17 +84,18 @@ void write_vtu(const std::string& path, const ParticleSnapshot& s) {
   const std::vector<std::uint8_t> types(n, 1);  // VTK_VERTEX
   write_block(types.data(), n);
   f << "\n</AppendedData>\n</VTKFile>\n";
+  f.close();
   if (!f) throw std::runtime_error("write failed: " + path + " (disk full?)");
+  file.commit();
 }
 
 void write_pvd(const std::string& path, const std::vector<std::pair<double, std::string>>& files) {
-  std::ofstream f(path);
-  if (!f) throw std::runtime_error("cannot write " + path);
+  std::ostringstream f;
   f << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
   for (const auto& [t, name] : files)
     f << "<DataSet timestep=\"" << t << "\" part=\"0\" file=\"" << name << "\"/>\n";
   f << "</Collection>\n</VTKFile>\n";
-  if (!f) throw std::runtime_error("write failed: " + path);
+  write_file_atomically(path, f.str());
 }
 
 }  // namespace crevasse

@@ -515,6 +515,40 @@ TEST(Reliability, FullDiskLeavesOldOrWholeFiles) {
   }
 }
 
+// The files of `crevasse run` are whole or absent too: under a 4 KiB file-size limit the run
+// fails at its first snapshot, and every file of a complete run's folder (VTU snapshots, the
+// PVD, the JSON and CSV files, the side views) is either the old one or the new one whole.
+TEST(Reliability, RunOutputsAreOldOrWhole) {
+  test::ScratchDir dir("rel_run_files");
+  nlohmann::json scene = test::tiny_scene(200);
+  scene["output"]["vtu_interval"] = 0.2;
+  scene["output"]["png"] = true;
+  test::write_text(dir / "scene.json", scene.dump(2));
+  ASSERT_EQ(run_cli(dir.path(), "run scene.json --out ref --threads 1 --quiet").code, 0);
+  std::vector<fs::path> files;
+  for (const auto& e : fs::recursive_directory_iterator(dir / "ref"))
+    if (e.is_regular_file()) files.push_back(fs::relative(e.path(), dir / "ref"));
+  ASSERT_GE(files.size(), 5u);
+  for (const fs::path& f : files) {
+    fs::create_directories((dir / "out" / f).parent_path());
+    test::write_text(dir / "out" / f, "old");
+  }
+  const std::string cmd = "cd '" + dir.path().string() + "' && bash -c \"trap '' XFSZ; ulimit -f 4; exec '" CREVASSE_BINARY
+                          "' run scene.json --out out --threads 1 --quiet\" > /dev/null 2>&1";
+  const int status = std::system(cmd.c_str());
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) != 0) << "the limit did not bite";
+  for (const fs::path& f : files) {
+    const std::string bytes = bytes_of(dir / "out" / f);
+    if (f == "run_summary.json") {  // holds wall times: whole means it parses
+      EXPECT_TRUE(bytes == "old" || nlohmann::json::accept(bytes)) << f << " is partial";
+      continue;
+    }
+    EXPECT_TRUE(bytes == "old" || bytes == bytes_of(dir / "ref" / f)) << f << " is partial";
+  }
+  for (const auto& e : fs::recursive_directory_iterator(dir / "out"))
+    EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path() << " left behind";
+}
+
 // Two merges into one new OUT: both succeed (the second waits for the first's lock and then
 // merges into the OUT the first made), in every round.
 TEST(Reliability, ConcurrentMergesIntoOneNewOutBothSucceed) {
