@@ -2,10 +2,13 @@
 #include "cli/cli_common.hpp"
 
 #include <tbb/global_control.h>
+#include <tbb/info.h>
+#include <tbb/task_arena.h>
 
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <new>
 #include <optional>
 
 #include "analysis/bed_contact.hpp"
@@ -17,6 +20,7 @@
 #include "engine/run.hpp"
 #include "engine/vtu_writer.hpp"
 #include "study/case_views.hpp"
+#include "study/memory_reserve.hpp"
 #include "study/scene_file.hpp"
 
 namespace crevasse {
@@ -27,6 +31,12 @@ namespace {
 class CliObserver : public RunObserver {
  public:
   CliObserver(fs::path out, bool quiet) : out_(std::move(out)), quiet_(quiet) {}
+  // A safe place to stop when an allocation had to take the memory reserve
+  // (study/memory_reserve.hpp): one line, exit 1.
+  bool cancelled() override {
+    if (memory_ran_out()) throw std::bad_alloc();
+    return false;
+  }
   void on_progress(const RunProgress& p) override {
     if (quiet_) return;
     char buf[256];
@@ -109,7 +119,11 @@ int run_command(const RunCommandOptions& opt) {
 
   CliObserver obs(out, opt.quiet);
   obs.set_measure_interval(opt.measure_interval);
-  RunSummary r = run_scene(scene, &obs);
+  // An arena of one slot starts no TBB worker: a worker that cannot start (ulimit -v, -u) ends
+  // the process from inside TBB, where no one can catch it.
+  RunSummary r;
+  tbb::task_arena arena(opt.threads > 0 ? opt.threads : tbb::info::default_concurrency());
+  arena.execute([&] { r = run_scene(scene, &obs); });
   obs.finish();
 
   nlohmann::json summary = {
