@@ -1,14 +1,12 @@
 #include "cli/run_command.hpp"
 #include "cli/cli_common.hpp"
 
-#include <tbb/global_control.h>
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
 
 #include <filesystem>
 #include <fstream>
 #include <memory>
-#include <new>
 #include <optional>
 
 #include "analysis/bed_contact.hpp"
@@ -34,7 +32,7 @@ class CliObserver : public RunObserver {
   // A safe place to stop when an allocation had to take the memory reserve
   // (study/memory_reserve.hpp): one line, exit 1.
   bool cancelled() override {
-    if (memory_ran_out()) throw std::bad_alloc();
+    throw_if_memory_ran_out();
     return false;
   }
   void on_progress(const RunProgress& p) override {
@@ -112,15 +110,11 @@ int run_command(const RunCommandOptions& opt) {
   if (ec)
     throw InputError("--out: cannot create directory " + out.string() + " (" + ec.message() + ")");
   write_file_atomically(out / "scene_resolved.json", scene_to_json(scene).dump(2) + "\n");
-  std::unique_ptr<tbb::global_control> threads;
-  if (opt.threads > 0)
-    threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                    opt.threads);
 
   CliObserver obs(out, opt.quiet);
   obs.set_measure_interval(opt.measure_interval);
-  // An arena of one slot starts no TBB worker: a worker that cannot start (ulimit -v, -u) ends
-  // the process from inside TBB, where no one can catch it.
+  // The arena bounds the threads (--threads). Under it a worker that cannot start (ulimit -v,
+  // -u) reaches this thread as an exception, one line and exit 1, not a termination inside TBB.
   RunSummary r;
   tbb::task_arena arena(opt.threads > 0 ? opt.threads : tbb::info::default_concurrency());
   arena.execute([&] { r = run_scene(scene, &obs); });

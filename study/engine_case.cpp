@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <new>
 #include <stdexcept>
 
 #include "analysis/measurement_io.hpp"
@@ -22,7 +21,7 @@ class CaseObserver : public RunObserver {
   void on_progress(const RunProgress& p) override { ctx_.report_fraction(p.fraction_done); }
   bool cancelled() override {
     // A safe place to fail when an allocation had to take the memory reserve.
-    if (memory_ran_out()) throw std::bad_alloc();
+    throw_if_memory_ran_out();
     return ctx_.should_stop();
   }
   double progress_interval_s() const override { return 0.5; }

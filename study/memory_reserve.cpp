@@ -111,6 +111,16 @@ bool arm_memory_reserve(std::size_t bytes) {
 
 bool memory_ran_out() { return g_ran_out.load(std::memory_order_relaxed); }
 
+void throw_if_memory_ran_out() {
+  if (memory_ran_out()) throw std::bad_alloc();
+}
+
+void top_up_memory_reserve() {
+  if (!g_armed) return;
+  std::lock_guard<std::mutex> lock(g_mutex);
+  if (!g_ran_out) take_reserve();
+}
+
 void rearm_memory_reserve() {
   if (!g_armed) return;
   std::lock_guard<std::mutex> lock(g_mutex);
@@ -124,6 +134,8 @@ void rearm_memory_reserve() {
 }  // namespace crevasse
 
 // The replaceable allocation functions ([new.delete.single], [new.delete.array]); libstdc++'s
-// nothrow forms call these, and operator delete stays the library's (std::free).
+// nothrow forms call these, and operator delete stays the library's (std::free). They replace
+// the library's in every program that links this object (the runner references it). The
+// aligned forms (align_val_t) keep the library's: nothing here allocates over-aligned types.
 void* operator new(std::size_t n) { return crevasse::allocate(n); }
 void* operator new[](std::size_t n) { return crevasse::allocate(n); }

@@ -18,6 +18,15 @@ bool arm_memory_reserve(std::size_t bytes);
 // True from the failure that gave the reserve back until rearm_memory_reserve().
 bool memory_ran_out();
 
+// Where throwing is safe (a run's progress poll, the end of a case): throws std::bad_alloc
+// when memory ran out. Memory is the process's, so the first case to poll fails and frees its
+// own, whichever thread took the reserve.
+void throw_if_memory_ran_out();
+
+// Takes back any part of the reserve that is missing, unless a failure is being handled (a
+// case start, where the previous case's memory is freed).
+void top_up_memory_reserve();
+
 // Called where an out-of-memory failure has been handled and its owner's memory freed: takes
 // the reserve again and lets the waiting threads go on. Does nothing when none was armed.
 void rearm_memory_reserve();

@@ -308,7 +308,7 @@ class StudyRun {
     const std::string started_at = started.started_at;
     queue_.push(std::move(started));
     if (exact_peak_rss_) reset_peak_rss();
-    rearm_memory_reserve();  // in case an earlier failure could not take it back
+    top_up_memory_reserve();  // in case an earlier failure could not take all of it back
     CaseContext ctx(threads, time_limit_, study_.measurement, stop(), fraction_[slot]);
     if (!opt_.views_dir.empty()) ctx.set_views_dir(opt_.views_dir);
     ctx.set_warn([this, slot](const std::string& m) { queue_.push(Event{Event::Kind::warning, slot, {}, {}, m}); });
@@ -323,7 +323,7 @@ class StudyRun {
     try {
       tbb::task_arena arena(threads);
       arena.execute([&] { outcome = case_function_(c, ctx); });
-      if (memory_ran_out()) throw std::bad_alloc();  // the reserve got the case through: still a failure
+      throw_if_memory_ran_out();  // the reserve got a case through: this one fails and frees its memory
     } catch (const SimulationError& e) {
       failure = e.what();
     } catch (const InputError& e) {
