@@ -12,6 +12,7 @@
 #include <tbb/task_arena.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -67,9 +68,22 @@ double run(const SceneConfig& scene, const std::string& checkpoint, long steps, 
 
 }  // namespace
 
+// A positive number, or exit 2 with a usage line (no uncaught exception on --help or a typo).
+double positive_arg(const char* text, const char* what) {
+  char* end = nullptr;
+  const double v = std::strtod(text, &end);
+  if (end == text || *end != '\0' || !(v > 0.0) || v > 1e9) {
+    std::fprintf(stderr, "bench_case: %s '%s' is not a positive number\n"
+                         "usage: bench_case [STEPS (default 400)] [THICKNESS_M (default 400)] [STUDY.json]\n",
+                 what, text);
+    std::exit(2);
+  }
+  return v;
+}
+
 int main(int argc, char** argv) {
-  const long steps = argc > 1 ? std::stol(argv[1]) : 400;
-  const double thickness = argc > 2 ? std::stod(argv[2]) : 400.0;
+  const long steps = argc > 1 ? static_cast<long>(positive_arg(argv[1], "STEPS")) : 400;
+  const double thickness = argc > 2 ? positive_arg(argv[2], "THICKNESS") : 400.0;
   const std::filesystem::path study_file =
       argc > 3 ? std::filesystem::path(argv[3])
                : std::filesystem::path(CREVASSE_SOURCE_DIR) / "studies/whole_case_cost.json";

@@ -16,6 +16,7 @@
 #include "cli/calibrate_command.hpp"
 #include "cli/export_command.hpp"
 #include "cli/fit_command.hpp"
+#include "cli/measure_command.hpp"
 #include "cli/plot_command.hpp"
 #include "cli/run_command.hpp"
 #include "cli/status_command.hpp"
@@ -97,6 +98,14 @@ int run_command_line(int argc, char** argv) {
   study->add_flag("--dry-run", study_opt.dry_run, "List the cases and their hashes; run nothing");
   study->add_flag("--quiet", study_opt.quiet, "No progress output");
   study->add_option("--views", study_opt.views_dir, "Folder for the side views of each case run (case_NNN_side_view.png, case_NNN_gate_view.png; NNN as in --dry-run)");
+  study->add_flag("--keep-particles", study_opt.keep_particles, "Keep each case's final particles in the --views folder (case_NNN_particles.bin, about 1 MB per 40 000 particles), to measure again with crevasse measure");
+
+  crevasse::MeasureCommandOptions measure_opt;
+  auto* measure = app.add_subcommand("measure", "Measure a case's final particles again (crevasse study --keep-particles, crevasse run), e.g. with other settings");
+  measure->add_option("file", measure_opt.particle_path, "Particle file (case_NNN_particles.bin, final_particles.bin)")->required();
+  measure->add_option("--set", measure_opt.settings, "Measurement setting KEY=VALUE over the case's own (repeatable; keys as in a study file's measurement, docs/measurement.md)");
+  measure->add_option("--out", measure_opt.out_dir, "Folder for crevasses.csv, measurement.json and the side views of this measurement");
+  measure->add_option("--vtu", measure_opt.vtu_path, "Write the particles as a VTU file for ParaView");
 
   crevasse::StatusCommandOptions status_opt;
   auto* status = app.add_subcommand("status", "Summarise a study database (safe while the study runs)");
@@ -184,6 +193,7 @@ int run_command_line(int argc, char** argv) {
       for (int i = 0; i < argc; ++i) study_opt.command_line += std::string(i ? " " : "") + argv[i];
       return crevasse::study_command(study_opt);
     }
+    if (*measure) return crevasse::measure_command(measure_opt);
     if (*status) return crevasse::status_command(status_opt);
     if (*export_cmd) return crevasse::export_command(export_opt);
     if (*merge) return crevasse::merge_command(merge_out, merge_in);

@@ -16,8 +16,10 @@
 #include "engine/atomic_file.hpp"
 #include "engine/error.hpp"
 #include "engine/run.hpp"
+#include "engine/particle_file.hpp"
 #include "engine/vtu_writer.hpp"
 #include "study/case_views.hpp"
+#include "study/engine_case.hpp"
 #include "study/memory_reserve.hpp"
 #include "study/scene_file.hpp"
 
@@ -103,7 +105,7 @@ int run_command(const RunCommandOptions& opt) {
   const fs::path out(opt.out_dir);
   check_output_directory("--out", out,
                          {"snapshots/", "scene_resolved.json", "run_summary.json", "crevasses.csv",
-                          "measurement.json", "measurements_over_time.csv", "side_view.png",
+                          "measurement.json", "measurements_over_time.csv", "final_particles.bin", "side_view.png",
                           "gate_view.png"});
   std::error_code ec;
   fs::create_directories(out / "snapshots", ec);
@@ -147,6 +149,8 @@ int run_command(const RunCommandOptions& opt) {
   obs.add_row(r.final_snapshot, m);
   analysis::write_crevasses_csv(m, out / "crevasses.csv");
   analysis::write_measurement_summary(m, out / "measurement.json");
+  write_particle_file(out / "final_particles.bin", r.final_snapshot,
+                      particle_file_metadata(scene, analysis::MeasureSettings{}, "", scene.name));
   if (scene.png) write_case_views(scene, r.final_snapshot, m, out);
   if (!opt.quiet) {
     std::fprintf(

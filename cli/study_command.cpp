@@ -10,6 +10,7 @@
 
 #include "cli/cli_common.hpp"
 #include "cli/progress_printer.hpp"
+#include "engine/error.hpp"
 #include "study/runner.hpp"
 #include "study/shard.hpp"
 #include "study/study_file.hpp"
@@ -145,6 +146,8 @@ int study_command(const StudyCommandOptions& opt) {
     return 0;
   }
 
+  if (opt.keep_particles && opt.views_dir.empty())
+    throw InputError("--keep-particles: the particles are kept beside the side views; give --views DIR too");
   if (!opt.views_dir.empty()) {
     std::vector<std::string> views;
     for (const StudyCase& c : study.cases) {
@@ -152,6 +155,7 @@ int study_command(const StudyCommandOptions& opt) {
       std::snprintf(stem, sizeof stem, "case_%03zu_", c.index);
       views.push_back(std::string(stem) + "side_view.png");
       views.push_back(std::string(stem) + "gate_view.png");
+      if (opt.keep_particles) views.push_back(std::string(stem) + "particles.bin");
     }
     check_output_directory("--views", opt.views_dir, views);
   }
@@ -181,6 +185,7 @@ int study_command(const StudyCommandOptions& opt) {
   ro.shard = shard;
   ro.command = opt.command_line;
   ro.views_dir = opt.views_dir;
+  ro.keep_particles = opt.keep_particles;
   ro.observer = opt.quiet ? nullptr : &console;
   // Shown even with --quiet: a warning says that work may have to be redone.
   ro.warn = [&console](const std::string& m) { console.warn(m); };

@@ -17,6 +17,7 @@ struct StudyCommandOptions {
   bool dry_run = false;  // list the cases and their hashes; run nothing, create nothing
   bool quiet = false;
   std::string views_dir;  // non-empty: side views of every case run, case_NNN_side_view.png
+  bool keep_particles = false;  // also case_NNN_particles.bin in views_dir
   std::string command_line;  // recorded in the sessions table
 };
 

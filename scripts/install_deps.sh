@@ -12,6 +12,7 @@ packages=(
   libcairo2-dev        # PNG/SVG figures (side views, regime diagrams)
   libcli11-dev         # command-line parsing of the crevasse CLI
   libbenchmark-dev     # bench/
+  zlib1g-dev           # compressed final-particle files (crevasse measure)
 )
 missing=()
 for p in "${packages[@]}"; do

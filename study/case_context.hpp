@@ -58,6 +58,9 @@ class CaseContext {
   // Where the case writes its side views (empty: none).
   void set_views_dir(std::filesystem::path dir) { views_dir_ = std::move(dir); }
   const std::filesystem::path& views_dir() const { return views_dir_; }
+  // Whether the case also keeps its final particles there (case_NNN_particles.bin).
+  void set_keep_particles(bool keep) { keep_particles_ = keep; }
+  bool keep_particles() const { return keep_particles_; }
 
  private:
   int threads_;
@@ -69,6 +72,7 @@ class CaseContext {
   std::filesystem::path checkpoint_file_;
   double checkpoint_interval_s_ = 0.0;
   std::filesystem::path views_dir_;
+  bool keep_particles_ = false;
   std::function<void(const std::string&)> warn_;
 };
 

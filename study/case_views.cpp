@@ -10,11 +10,17 @@ namespace crevasse {
 void write_case_views(const SceneConfig& scene, const ParticleSnapshot& final_snapshot,
                       const analysis::CrevasseMeasurement& m, const std::filesystem::path& dir,
                       const std::string& stem) {
+  write_case_views(cohesion_ratio(scene.tensile_strength, scene.density, scene.gravity, scene.ice_thickness),
+                   final_snapshot, m, dir, stem);
+}
+
+void write_case_views(double pi_group, const ParticleSnapshot& final_snapshot,
+                      const analysis::CrevasseMeasurement& m, const std::filesystem::path& dir,
+                      const std::string& stem) {
   if (final_snapshot.size() == 0) return;
   analysis::SideViewOptions view;
   char extra[128];
-  const double pi_group = cohesion_ratio(scene.tensile_strength, scene.density, scene.gravity, scene.ice_thickness);
-  std::snprintf(extra, sizeof extra, "c = %.3g MPa   Pi = %.3g", scene.tensile_strength / 1e6, pi_group);
+  std::snprintf(extra, sizeof extra, "c = %.3g MPa   Pi = %.3g", final_snapshot.tensile_strength_pa / 1e6, pi_group);
   view.title_extra = extra;
   const std::string side = (dir / (stem + "side_view.png")).string();
   if (m.settings.frame != "gate") {

@@ -15,5 +15,9 @@ namespace crevasse {
 void write_case_views(const SceneConfig& scene, const ParticleSnapshot& final_snapshot,
                       const analysis::CrevasseMeasurement& m, const std::filesystem::path& dir,
                       const std::string& stem = "");
+// The same for a snapshot read back from a particle file: the title carries c and this Π.
+void write_case_views(double pi_group, const ParticleSnapshot& final_snapshot,
+                      const analysis::CrevasseMeasurement& m, const std::filesystem::path& dir,
+                      const std::string& stem = "");
 
 }  // namespace crevasse

@@ -8,9 +8,11 @@
 
 #include "analysis/measurement_io.hpp"
 #include "engine/error.hpp"
+#include "engine/particle_file.hpp"
 #include "engine/run.hpp"
 #include "study/case_views.hpp"
 #include "study/memory_reserve.hpp"
+#include "study/study_file.hpp"
 
 namespace crevasse {
 namespace {
@@ -44,6 +46,16 @@ void check_finite(const ParticleSnapshot& s) {
 }
 
 }  // namespace
+
+nlohmann::json particle_file_metadata(const SceneConfig& scene, const analysis::MeasureSettings& measurement,
+                                     const std::string& case_id, const std::string& label) {
+  return {{"case_id", case_id},
+          {"label", label},
+          {"engine_version", CREVASSE_ENGINE_VERSION},
+          {"density_kg_m3", scene.density},
+          {"gravity_m_s2", scene.gravity},
+          {"measurement", measure_settings_to_json(measurement)}};
+}
 
 CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx) {
   SceneConfig scene = study_case.scene;
@@ -101,6 +113,10 @@ CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx) {
     char stem[32];
     std::snprintf(stem, sizeof stem, "case_%03zu_", study_case.index);
     write_case_views(study_case.scene, r.final_snapshot, *out.measurement, ctx.views_dir(), stem);
+    if (ctx.keep_particles())
+      write_particle_file(ctx.views_dir() / (std::string(stem) + "particles.bin"), r.final_snapshot,
+                          particle_file_metadata(study_case.scene, ctx.measurement(), study_case.case_id,
+                                                 study_case.label));
   }
   return out;
 }

@@ -10,4 +10,9 @@ namespace crevasse {
 // Throws SimulationError on instability, time limit or non-finite results.
 CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx);
 
+// What a kept particle file carries besides the particles (engine/particle_file.hpp): the case,
+// ρ_i and g (for Π), and the study's measurement settings, which `crevasse measure` starts from.
+nlohmann::json particle_file_metadata(const SceneConfig& scene, const analysis::MeasureSettings& measurement,
+                                      const std::string& case_id, const std::string& label);
+
 }  // namespace crevasse

@@ -70,6 +70,7 @@ struct RunnerOptions {
   // the case's label; called on the calling thread. Empty: not shown.
   std::function<void(const std::string&)> warn;
   std::filesystem::path views_dir;  // non-empty: each case writes its side views there
+  bool keep_particles = false;      // and its final particles (needs views_dir)
   // Set from outside (a signal handler) to end the session early: no new case starts, and the
   // running ones save a checkpoint and stay pending for the next session (report.interrupted).
   std::atomic<bool>* interrupt = nullptr;

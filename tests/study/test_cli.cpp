@@ -369,5 +369,68 @@ TEST(Cli, SigkillDuringAStudyThenResumeLosesAndRerunsNothing) {
   EXPECT_EQ(test::result_dump(dir / "k.db"), test::result_dump(dir / "ref.db"));
 }
 
+// Kept particles measure again as the case was measured: `crevasse run` writes
+// final_particles.bin, and `crevasse measure` on it with the run's settings writes the very
+// measurement.json the run wrote; --set changes a setting, a bad one is refused naming it.
+TEST(Cli, MeasureAgainReproducesTheRunsMeasurementAndTakesOtherSettings) {
+  test::ScratchDir dir("cli");
+  nlohmann::json scene = test::tiny_scene();
+  scene["run"] = {{"end_time", 30.0}};
+  test::write_text(dir / "scene.json", scene.dump());
+  const Result r = run_cli(dir.path(), "run scene.json --out out --quiet");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Result again = run_cli(dir.path(), "measure out/final_particles.bin --out m --vtu m/final.vtu");
+  ASSERT_EQ(again.code, 0) << again.err;
+  EXPECT_EQ(nlohmann::json::parse(read_file(dir / "out/measurement.json")),
+            nlohmann::json::parse(read_file(dir / "m/measurement.json")));
+  EXPECT_EQ(read_file(dir / "out/crevasses.csv"), read_file(dir / "m/crevasses.csv"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "m/final.vtu"));
+  EXPECT_NE(again.out.find("frame gate"), std::string::npos) << again.out;
+
+  const Result other = run_cli(dir.path(), "measure out/final_particles.bin --set frame=final --set spacing_rule=drop");
+  ASSERT_EQ(other.code, 0) << other.err;
+  EXPECT_NE(other.out.find("frame final"), std::string::npos) << other.out;
+  EXPECT_NE(other.out.find("rule drop"), std::string::npos) << other.out;
+
+  for (const char* bad : {"--set frame=sideways", "--set min_depth_over_dx=-1", "--set nonsense=1", "--set frame"}) {
+    const Result refused = run_cli(dir.path(), std::string("measure out/final_particles.bin ") + bad);
+    EXPECT_EQ(refused.code, 2) << bad;
+    EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+  }
+  const Result missing = run_cli(dir.path(), "measure out/nothing.bin");
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_NE(missing.err.find("nothing.bin"), std::string::npos) << missing.err;
+}
+
+// `crevasse study --keep-particles` keeps each case's final particles beside its side views;
+// measured again they give the case's stored crevasse count, and the file names the case.
+TEST(Cli, StudyKeepsParticlesThatMeasureAsStored) {
+  test::ScratchDir dir("cli");
+  test::write_text(dir / "s.json", test::tiny_study(2, 200, "keep").dump(2));
+  const Result no_views = run_cli(dir.path(), "study s.json --keep-particles");
+  EXPECT_EQ(no_views.code, 2);
+  EXPECT_NE(no_views.err.find("--views"), std::string::npos) << no_views.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "results"));
+
+  const Result run = run_cli(dir.path(), "study s.json --views v --keep-particles --quiet");
+  ASSERT_EQ(run.code, 0) << run.err;
+  const auto rows = test::dump_rows(dir / "results/keep.db",
+                                    "SELECT c.case_index, c.case_id, s.crevasse_count FROM cases c "
+                                    "JOIN summaries s USING (case_id) ORDER BY c.case_index");
+  ASSERT_EQ(rows.size(), 2u);
+  for (int k = 0; k < 2; ++k) {
+    char file[64];
+    std::snprintf(file, sizeof file, "v/case_%03d_particles.bin", k);
+    const Result m = run_cli(dir.path(), std::string("measure ") + file);
+    ASSERT_EQ(m.code, 0) << m.err;
+    // rows: "index|case_id|count"
+    const std::string row = rows[k];
+    const std::string id = row.substr(row.find('|') + 1, row.rfind('|') - row.find('|') - 1);
+    const std::string count = row.substr(row.rfind('|') + 1);
+    EXPECT_NE(m.out.find("case " + id), std::string::npos) << m.out;
+    EXPECT_NE(m.out.find("crevasses " + count + " "), std::string::npos) << m.out << " vs " << row;
+  }
+}
+
 }  // namespace
 }  // namespace crevasse
