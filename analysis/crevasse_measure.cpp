@@ -10,6 +10,7 @@
 
 #include "analysis/damage_clusters.hpp"
 #include "analysis/damage_criterion.hpp"
+#include "analysis/opened_gaps.hpp"
 
 namespace crevasse::analysis {
 
@@ -168,6 +169,7 @@ ResolvedMeasureSettings resolve_in_frame(const ParticleSnapshot& snapshot,
     throw std::invalid_argument("spacing_rule: value \"" + settings.spacing_rule +
                                 "\" is not \"merge\" or \"drop\"");
   r.spacing_rule = settings.spacing_rule;
+  r.count_gaps = settings.count_gaps && !gate;
   r.min_depth_m = settings.min_depth_over_dx * r.dx_m;
   r.link_distance_m = settings.link_distance_over_spacing * r.particle_spacing_m;
   r.surface_reach_m = settings.surface_reach_over_dx * r.dx_m;
@@ -304,6 +306,13 @@ CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
         static_cast<double>(broken) > r.fragmented_fraction * static_cast<double>(occupied);
   }
 
+  if (r.count_gaps) {  // after the counts above, which are of particles only
+    const GapPoints gaps =
+        find_opened_gaps(px, pz, m.surface, snapshot.bed_profile, r.dx_m, r.particle_spacing_m);
+    px.insert(px.end(), gaps.x.begin(), gaps.x.end());
+    pz.insert(pz.end(), gaps.z.begin(), gaps.z.end());
+    damaged.insert(damaged.end(), gaps.x.size(), 1);
+  }
   const DamageClusters clusters = find_damage_clusters(px, pz, damaged, r.link_distance_m);
   m.cluster_count = clusters.count;
   // Each place where a damaged cluster meets the surface is a crevasse of its own: one cluster

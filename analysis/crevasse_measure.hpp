@@ -50,6 +50,12 @@ struct MeasureSettings {
   //   "drop":  the source study's rule: both are kept, only the spacing between them is dropped
   //            and counted.
   std::string spacing_rule = "merge";
+  // Whether an opened gap inside the ice counts as part of a fracture (final and passed frames):
+  // a cell dx wide with no particle, below the bridged surface and above the bed, is filled with
+  // damaged points on the particle lattice before the clusters are found. A crack that has
+  // opened leaves intact ice on either side and empty cells between them, which the damaged
+  // particles alone do not link (docs/measurement.md, "Opened gaps").
+  bool count_gaps = false;
   // A crevasse shallower than this is not resolved either (a damaged lens one or two particle
   // rows under the surface cannot be told from an opening at this resolution): not counted,
   // and counted in shallow_count instead. 0 counts every surface-reaching cluster.
@@ -94,6 +100,7 @@ struct ResolvedMeasureSettings {
   double particle_spacing_m = 0.0;
   double resolution_floor_m = 0.0;
   std::string spacing_rule = "merge";
+  bool count_gaps = false;
   double min_depth_m = 0.0;
   double link_distance_m = 0.0;
   double surface_reach_m = 0.0;

@@ -76,6 +76,7 @@ nlohmann::json settings_to_json(const ResolvedMeasureSettings& s) {
       {"fragmented_fraction", s.fragmented_fraction},
       {"dim", s.dim},
   };
+  if (s.count_gaps) j["count_gaps"] = true;  // absent when off, so stored results stay as they were
   if (s.dim == 3) {
     j["y_band_center_m"] = s.y_band_center_m;
     j["y_band_width_m"] = s.y_band_width_m;

@@ -177,6 +177,14 @@ TEST(StudyFile, ResourcesAndMeasurementSettings) {
   ASSERT_TRUE(s.measurement.window_min_x_m.has_value());
   EXPECT_EQ(*s.measurement.window_min_x_m, 100.0);
   EXPECT_EQ(s.measurement_json["surface_smoothing_bins"], 5);
+  // count_gaps is written only when on, so that studies without it keep their hashes.
+  EXPECT_FALSE(s.measurement.count_gaps);
+  EXPECT_FALSE(s.measurement_json.contains("count_gaps"));
+  j["measurement"]["count_gaps"] = true;
+  const Study g = parse(j);
+  EXPECT_TRUE(g.measurement.count_gaps);
+  EXPECT_EQ(g.measurement_json["count_gaps"], true);
+  EXPECT_NE(g.study_hash, s.study_hash);
 }
 
 // Each mistake gets its own message naming the field (and the value and range where there is one).
@@ -208,6 +216,8 @@ const BadStudy kBadStudies[] = {
        j["sweep"] = {{"cohesion_ratio", {{"log", {-0.1, 1.0, 4}}}}};
      },
      {"sweep.cohesion_ratio.log", "-0.1", "(0, inf)"}},
+    {"count_gaps not a boolean", [](json& j) { j["measurement"] = {{"count_gaps", "yes"}}; },
+     {"measurement.count_gaps", "\"yes\"", "true or false"}},
     {"log range with zero",
      [](json& j) {
        j["sweep"] = {{"cohesion_ratio", {{"log", {0.0, 1.0, 4}}}}};
