@@ -19,13 +19,21 @@ namespace {
 
 class CaseObserver : public RunObserver {
  public:
-  explicit CaseObserver(CaseContext& ctx) : ctx_(ctx) {}
-  void on_progress(const RunProgress& p) override { ctx_.report_fraction(p.fraction_done); }
+  CaseObserver(CaseContext& ctx, double time_limit_s) : ctx_(ctx), time_limit_s_(time_limit_s) {}
+  void on_progress(const RunProgress& p) override {
+    ctx_.report_fraction(p.fraction_done);
+    fraction_ = p.fraction_done;
+    settled_ = true;  // progress is reported only once the settling phase is over
+  }
   bool cancelled() override {
     // A safe place to fail when an allocation had to take the memory reserve.
     throw_if_memory_ran_out();
-    return ctx_.should_stop();
+    if (time_limit_s_ > 0 && ctx_.elapsed_s() > time_limit_s_) timed_out_ = true;
+    return timed_out_ || ctx_.should_stop();
   }
+  bool timed_out() const { return timed_out_; }
+  bool settled() const { return settled_; }
+  double fraction() const { return fraction_; }
   double progress_interval_s() const override { return 0.5; }
   std::string checkpoint_path() const override { return ctx_.checkpoint_file().string(); }
   double checkpoint_interval_s() const override { return ctx_.checkpoint_interval_s(); }
@@ -33,6 +41,9 @@ class CaseObserver : public RunObserver {
 
  private:
   CaseContext& ctx_;
+  double time_limit_s_;
+  bool timed_out_ = false, settled_ = false;
+  double fraction_ = 0.0;
 };
 
 void check_finite(const ParticleSnapshot& s) {
@@ -61,14 +72,27 @@ CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx) {
   SceneConfig scene = study_case.scene;
   scene.vtu_interval = 0.0;
   scene.png = false;
-  if (ctx.time_limit_s() > 0)
-    scene.wall_time_limit = scene.wall_time_limit > 0
-                                ? std::min(scene.wall_time_limit, ctx.time_limit_s())
-                                : ctx.time_limit_s();
-  CaseObserver observer(ctx);
+  // The shorter of the scene's run.wall_time_limit and the case's time limit, enforced here by
+  // cancelling the run rather than by the engine: a cancelled run saves its checkpoint, and the
+  // scene inside the checkpoint does not carry the limit, so a case that ran out of time
+  // continues from where it stopped once the limit is raised (the runner keeps the checkpoint).
+  double time_limit = scene.wall_time_limit;
+  if (ctx.time_limit_s() > 0) time_limit = time_limit > 0 ? std::min(time_limit, ctx.time_limit_s()) : ctx.time_limit_s();
+  scene.wall_time_limit = 0.0;
+  CaseObserver observer(ctx, time_limit);
   RunSummary r = run_scene(scene, &observer);
 
   CaseOutcome out;
+  if (r.stop_reason == "cancelled" && observer.timed_out()) {
+    char what[200];
+    if (observer.settled())
+      std::snprintf(what, sizeof what, "time limit: %g s (run.wall_time_limit or the case time limit) reached at t = %.1f s (%.0f%% done)",
+                    time_limit, r.sim_time_s, 100.0 * observer.fraction());
+    else
+      std::snprintf(what, sizeof what, "time limit: %g s (run.wall_time_limit or the case time limit) reached while settling",
+                    time_limit);
+    throw SimulationError(what);
+  }
   if (r.stop_reason == "cancelled") {
     out.cancelled = true;
     return out;

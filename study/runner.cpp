@@ -346,9 +346,15 @@ class StudyRun {
       }
       failure = "time limit: the case ran longer than the case time limit of " + std::to_string(time_limit_) + " s";
     }
-    if (!checkpoint.empty()) {  // finished or failed for good: nothing to continue from
+    // A case out of time keeps its checkpoint, to continue from under a larger limit; any other
+    // end is final: nothing to continue from.
+    const bool out_of_time = failure.rfind("time limit", 0) == 0;
+    if (!checkpoint.empty()) {
       std::error_code ec;
-      std::filesystem::remove(checkpoint, ec);
+      if (!out_of_time)
+        std::filesystem::remove(checkpoint, ec);
+      else if (std::filesystem::is_regular_file(checkpoint, ec))
+        failure += "; its checkpoint is kept: raise the limit and run again with --retry-failed to continue from it";
     }
     CaseResult r;
     r.case_id = c.case_id;

@@ -251,6 +251,46 @@ TEST(Cli, KilledCaseResumesFromItsCheckpoint) {
   EXPECT_EQ(test::result_dump(dir / "k.db"), test::result_dump(dir / "ref.db"));
 }
 
+// A case that runs out of time keeps its checkpoint: the failure says so, and under a larger
+// limit --retry-failed continues it from there to the uninterrupted result. (The limit is not
+// part of the case, so raising it keeps the case and its checkpoint.)
+TEST(Cli, CaseOutOfTimeKeepsItsCheckpointAndRetryContinuesIt) {
+  test::ScratchDir dir("cli");
+  nlohmann::json study = test::tiny_study(2, 60000, "late");
+  study["sweep"] = {{"cohesion_ratio", {0.3}}};
+  study["resources"] = {{"checkpoint_interval_s", 0.2}};
+  test::write_text(dir / "s.json", study.dump(2));
+  const auto t0 = std::chrono::steady_clock::now();
+  const Result ref = run_cli(dir.path(), "study s.json --db ref.db --jobs 1 --threads-per-case 1 --quiet");
+  ASSERT_EQ(ref.code, 0) << ref.err;
+  ASSERT_GT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 2.0)
+      << "the case is too short for a 1 s limit; make it longer";
+
+  study["base_scene"]["run"]["wall_time_limit"] = 1.0;
+  test::write_text(dir / "s.json", study.dump(2));
+  const Result late = run_cli(dir.path(), "study s.json --db k.db --jobs 1 --threads-per-case 1 --quiet");
+  EXPECT_EQ(late.code, 1) << late.err;
+  const auto reason = test::dump_rows(dir / "k.db", "SELECT status, failure_reason FROM cases");
+  ASSERT_EQ(reason.size(), 1u);
+  EXPECT_EQ(reason[0].rfind("failed|time limit: 1 s", 0), 0u) << reason[0];
+  EXPECT_NE(reason[0].find("checkpoint is kept"), std::string::npos) << reason[0];
+  ASSERT_FALSE(std::filesystem::is_empty(dir / "k.db.checkpoints"));
+
+  study["base_scene"]["run"].erase("wall_time_limit");
+  test::write_text(dir / "s.json", study.dump(2));
+  const Result retried = run_cli(dir.path(), "study s.json --db k.db --jobs 1 --threads-per-case 1 --quiet --retry-failed");
+  ASSERT_EQ(retried.code, 0) << retried.err;
+  const auto resumed_from = test::dump_rows(
+      dir / "k.db", "SELECT json_extract(run_json, '$.resumed_from_time_s') FROM cases");
+  ASSERT_EQ(resumed_from.size(), 1u);
+  EXPECT_GT(std::stod(resumed_from[0]), 0.0) << "the case started again from t = 0";
+  EXPECT_TRUE(std::filesystem::is_empty(dir / "k.db.checkpoints"));
+  // The stored scene and study text keep the limit the case was registered with; the result is
+  // the uninterrupted run's.
+  const std::string results = "SELECT case_id, status, steps, particle_steps, result_hash FROM cases";
+  EXPECT_EQ(test::dump_rows(dir / "k.db", results), test::dump_rows(dir / "ref.db", results));
+}
+
 // A write that fails (here: a file-size limit, as a full disk would) ends the study with a
 // clear one-line message and exit code 1; the database stays sound with whole cases only, and
 // the same command resumes it to the uninterrupted result. A database path on a read-only file
