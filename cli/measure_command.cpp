@@ -7,6 +7,7 @@
 #include "analysis/measurement_io.hpp"
 #include "cli/cli_common.hpp"
 #include "engine/error.hpp"
+#include "engine/groups.hpp"
 #include "engine/particle_file.hpp"
 #include "engine/vtu_writer.hpp"
 #include "study/case_views.hpp"
@@ -85,8 +86,11 @@ int measure_command(const MeasureCommandOptions& opt) {
     analysis::write_crevasses_csv(m, out / "crevasses.csv");
     analysis::write_measurement_summary(m, out / "measurement.json");
     const double rho = file.metadata.value("density_kg_m3", 0.0), g = file.metadata.value("gravity_m_s2", 0.0);
-    const double h = file.snapshot.ice_thickness_m;
-    write_case_views(rho * g * h > 0 ? file.snapshot.tensile_strength_pa / (rho * g * h) : 0.0, file.snapshot, m, out);
+    const ParticleSnapshot& s = file.snapshot;
+    const double pi_group = rho * g * s.ice_thickness_m > 0
+                                ? cohesion_ratio(s.tensile_strength_pa, rho, g, s.ice_thickness_m)
+                                : 0.0;
+    write_case_views(pi_group, s, m, out);
   }
   if (!opt.vtu_path.empty()) write_vtu(opt.vtu_path, file.snapshot);
   return 0;

@@ -19,6 +19,9 @@ namespace crevasse {
 // What a case hands back to the runner.
 struct CaseOutcome {
   bool cancelled = false;  // stopped because the runner asked (fail-fast): stays pending
+  // Set with `cancelled` when the case stopped at its time limit instead: why, for the failure.
+  // The run saved its checkpoint, which the runner keeps.
+  std::optional<std::string> out_of_time;
   std::string stop_reason;
   std::int64_t steps = 0;
   std::int64_t particle_steps = 0;

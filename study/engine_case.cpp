@@ -84,6 +84,7 @@ CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx) {
 
   CaseOutcome out;
   if (r.stop_reason == "cancelled" && observer.timed_out()) {
+    out.cancelled = true;
     char what[200];
     if (observer.settled())
       std::snprintf(what, sizeof what, "time limit: %g s (run.wall_time_limit or the case time limit) reached at t = %.1f s (%.0f%% done)",
@@ -91,7 +92,8 @@ CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx) {
     else
       std::snprintf(what, sizeof what, "time limit: %g s (run.wall_time_limit or the case time limit) reached while settling",
                     time_limit);
-    throw SimulationError(what);
+    out.out_of_time = what;
+    return out;
   }
   if (r.stop_reason == "cancelled") {
     out.cancelled = true;

@@ -339,16 +339,18 @@ class StudyRun {
     // The case's memory is freed by now: after running out, take the reserve back and let the
     // other cases go on.
     if (!failure.empty()) rearm_memory_reserve();
+    bool out_of_time = false;
     if (failure.empty() && outcome.cancelled) {
-      if (!ctx.time_limit_exceeded()) {
+      if (!outcome.out_of_time && !ctx.time_limit_exceeded()) {
         queue_.push(Event{Event::Kind::cancelled, slot, {}, started_at});
         return;
       }
-      failure = "time limit: the case ran longer than the case time limit of " + std::to_string(time_limit_) + " s";
+      out_of_time = true;
+      failure = outcome.out_of_time.value_or("time limit: the case ran longer than the case time limit of " +
+                                             std::to_string(time_limit_) + " s");
     }
     // A case out of time keeps its checkpoint, to continue from under a larger limit; any other
     // end is final: nothing to continue from.
-    const bool out_of_time = failure.rfind("time limit", 0) == 0;
     if (!checkpoint.empty()) {
       std::error_code ec;
       if (!out_of_time)

@@ -443,10 +443,13 @@ TEST(Cli, MeasureAgainReproducesTheRunsMeasurementAndTakesOtherSettings) {
 }
 
 // `crevasse study --keep-particles` keeps each case's final particles beside its side views;
-// measured again they give the case's stored crevasse count, and the file names the case.
+// measured again they give the case's stored summary (crevasse count, window, particle, damage
+// and cluster counts), and the file names the case.
 TEST(Cli, StudyKeepsParticlesThatMeasureAsStored) {
   test::ScratchDir dir("cli");
-  test::write_text(dir / "s.json", test::tiny_study(2, 200, "keep").dump(2));
+  nlohmann::json study = test::tiny_study(2, 200, "keep");
+  study["base_scene"]["run"] = {{"end_time", 30.0}};  // long enough for some ice to break
+  test::write_text(dir / "s.json", study.dump(2));
   const Result no_views = run_cli(dir.path(), "study s.json --keep-particles");
   EXPECT_EQ(no_views.code, 2);
   EXPECT_NE(no_views.err.find("--views"), std::string::npos) << no_views.err;
@@ -455,21 +458,35 @@ TEST(Cli, StudyKeepsParticlesThatMeasureAsStored) {
   const Result run = run_cli(dir.path(), "study s.json --views v --keep-particles --quiet");
   ASSERT_EQ(run.code, 0) << run.err;
   const auto rows = test::dump_rows(dir / "results/keep.db",
-                                    "SELECT c.case_index, c.case_id, s.crevasse_count FROM cases c "
-                                    "JOIN summaries s USING (case_id) ORDER BY c.case_index");
+                                    "SELECT c.case_id, s.crevasse_count, s.window_min_x_m, s.window_max_x_m, "
+                                    "s.particle_count, s.window_particle_count, s.damaged_particle_count, "
+                                    "s.cluster_count FROM cases c JOIN summaries s USING (case_id) ORDER BY c.case_index");
   ASSERT_EQ(rows.size(), 2u);
+  std::int64_t damaged = 0;
   for (int k = 0; k < 2; ++k) {
     char file[64];
     std::snprintf(file, sizeof file, "v/case_%03d_particles.bin", k);
-    const Result m = run_cli(dir.path(), std::string("measure ") + file);
+    const std::string out = "m" + std::to_string(k);
+    const Result m = run_cli(dir.path(), std::string("measure ") + file + " --out " + out);
     ASSERT_EQ(m.code, 0) << m.err;
-    // rows: "index|case_id|count"
-    const std::string row = rows[k];
-    const std::string id = row.substr(row.find('|') + 1, row.rfind('|') - row.find('|') - 1);
-    const std::string count = row.substr(row.rfind('|') + 1);
+    const nlohmann::json j = nlohmann::json::parse(read_file(dir / out / "measurement.json"));
+    const std::string id = rows[k].substr(0, rows[k].find('|'));
     EXPECT_NE(m.out.find("case " + id), std::string::npos) << m.out;
-    EXPECT_NE(m.out.find("crevasses " + count + " "), std::string::npos) << m.out << " vs " << row;
+    std::vector<std::string> f;
+    std::istringstream fields(rows[k]);
+    for (std::string x; std::getline(fields, x, '|');) f.push_back(x);
+    ASSERT_EQ(f.size(), 8u) << rows[k];
+    const auto& c = j.at("counts");
+    EXPECT_EQ(std::stoll(f[1]), j.at("crevasse_count").get<std::int64_t>());
+    EXPECT_NEAR(std::stod(f[2]), j.at("settings").at("window_min_x_m").get<double>(), 1e-9);
+    EXPECT_NEAR(std::stod(f[3]), j.at("settings").at("window_max_x_m").get<double>(), 1e-9);
+    EXPECT_EQ(std::stoll(f[4]), c.at("particles").get<std::int64_t>());
+    EXPECT_EQ(std::stoll(f[5]), c.at("window_particles").get<std::int64_t>());
+    EXPECT_EQ(std::stoll(f[6]), c.at("damaged_particles").get<std::int64_t>());
+    EXPECT_EQ(std::stoll(f[7]), c.at("damage_clusters").get<std::int64_t>());
+    damaged += c.at("damaged_particles").get<std::int64_t>();
   }
+  EXPECT_GT(damaged, 0) << "nothing was damaged: the comparison shows little; run the cases longer";
 }
 
 }  // namespace
