@@ -25,6 +25,13 @@ std::uint64_t checksum(const char* data, std::size_t n) {
   return h;
 }
 
+// The scene a checkpoint belongs to. The wall-time limit is left out: a run stopped by it
+// continues under a larger one.
+static std::string scene_identity(SceneConfig scene) {
+  scene.wall_time_limit = 0.0;
+  return scene_to_json(scene).dump();
+}
+
 }  // namespace checkpoint
 
 template <int Dim>
@@ -34,7 +41,7 @@ void save_checkpoint(const std::string& path, const SceneConfig& scene, const Ru
   // The payload is assembled in memory first, so that its checksum can follow it.
   std::ostringstream o(std::ios::binary);
   ck::put_string(o, CREVASSE_ENGINE_VERSION);
-  ck::put_string(o, scene_to_json(scene).dump());
+  ck::put_string(o, ck::scene_identity(scene));
   ck::put(o, static_cast<std::int32_t>(Dim));
   ck::put(o, run.time); ck::put(o, run.dt); ck::put(o, run.steps); ck::put(o, run.particle_steps);
   ck::put(o, run.return_map_evaluations); ck::put(o, run.removed_mass); ck::put(o, run.front_x);
@@ -107,7 +114,7 @@ void load_checkpoint(const std::string& path, const SceneConfig& scene, RunCount
   std::istringstream i(bytes.substr(sizeof ck::kMagic, payload_size), std::ios::binary);
   bytes.clear();
   if (ck::get_string(i, 64) != CREVASSE_ENGINE_VERSION) throw bad("written by another engine version");
-  if (ck::get_string(i, 1u << 24) != scene_to_json(scene).dump()) throw bad("written for another scene");
+  if (ck::get_string(i, 1u << 24) != ck::scene_identity(scene)) throw bad("written for another scene");
   std::int32_t dim = 0;
   ck::get(i, dim);
   if (dim != Dim) throw bad("written for another dimension");

@@ -52,7 +52,8 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
       std::snprintf(msg, sizeof msg, "time limit: run.wall_time_limit = %g s reached %s%.6g s, step %lld (%d%% done)",
                     scene.wall_time_limit, sim.settled() ? "at t = " : "while settling, at settling time ",
                     sim.time(), static_cast<long long>(sim.steps()), static_cast<int>(100 * done));
-      throw SimulationError(msg);
+      if (!checkpoint.empty()) save_checkpoint();
+      throw TimeLimitError(msg, scene.wall_time_limit, sim.time(), done, sim.settled());
     }
   };
   // The front that counts is that of the connected ice, not of debris thrown ahead of it.

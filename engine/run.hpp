@@ -91,8 +91,9 @@ struct RunSummary {
   ParticleSnapshot final_snapshot;
 };
 
-// Throws SimulationError on instability or when run.wall_time_limit is exceeded (both checked
-// between steps, the settling phase included).
+// Throws SimulationError on instability, and TimeLimitError (after saving the checkpoint, if
+// any) when run.wall_time_limit is exceeded; both are checked between steps, the settling phase
+// included.
 RunSummary run_scene(const SceneConfig& scene, RunObserver* observer = nullptr);
 
 }  // namespace crevasse

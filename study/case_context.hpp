@@ -42,7 +42,9 @@ class CaseContext {
   double time_limit_s() const { return time_limit_s_; }  // 0 = none
   const analysis::MeasureSettings& measurement() const { return measurement_; }
   bool time_limit_exceeded() const;
-  bool should_stop() const { return stop_.load() || time_limit_exceeded(); }
+  // The runner's stop signal, or the time limit for a case function that has no clock of its own.
+  bool should_stop() const { return stop_requested() || time_limit_exceeded(); }
+  bool stop_requested() const { return stop_.load(); }
   void report_fraction(double f) { fraction_.store(f); }
   double elapsed_s() const;
   // Where the case keeps its checkpoint and how often it writes it (wall s); empty: none.

@@ -19,21 +19,14 @@ namespace {
 
 class CaseObserver : public RunObserver {
  public:
-  CaseObserver(CaseContext& ctx, double time_limit_s) : ctx_(ctx), time_limit_s_(time_limit_s) {}
-  void on_progress(const RunProgress& p) override {
-    ctx_.report_fraction(p.fraction_done);
-    fraction_ = p.fraction_done;
-    settled_ = true;  // progress is reported only once the settling phase is over
-  }
+  explicit CaseObserver(CaseContext& ctx) : ctx_(ctx) {}
+  void on_progress(const RunProgress& p) override { ctx_.report_fraction(p.fraction_done); }
   bool cancelled() override {
     // A safe place to fail when an allocation had to take the memory reserve.
     throw_if_memory_ran_out();
-    if (time_limit_s_ > 0 && ctx_.elapsed_s() > time_limit_s_) timed_out_ = true;
-    return timed_out_ || ctx_.should_stop();
+    // The stop signal only: the time limit is the engine's (run.wall_time_limit).
+    return ctx_.stop_requested();
   }
-  bool timed_out() const { return timed_out_; }
-  bool settled() const { return settled_; }
-  double fraction() const { return fraction_; }
   double progress_interval_s() const override { return 0.5; }
   std::string checkpoint_path() const override { return ctx_.checkpoint_file().string(); }
   double checkpoint_interval_s() const override { return ctx_.checkpoint_interval_s(); }
@@ -41,9 +34,6 @@ class CaseObserver : public RunObserver {
 
  private:
   CaseContext& ctx_;
-  double time_limit_s_;
-  bool timed_out_ = false, settled_ = false;
-  double fraction_ = 0.0;
 };
 
 void check_finite(const ParticleSnapshot& s) {
@@ -72,29 +62,32 @@ CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx) {
   SceneConfig scene = study_case.scene;
   scene.vtu_interval = 0.0;
   scene.png = false;
-  // The shorter of the scene's run.wall_time_limit and the case's time limit, enforced here by
-  // cancelling the run rather than by the engine: a cancelled run saves its checkpoint, and the
-  // scene inside the checkpoint does not carry the limit, so a case that ran out of time
-  // continues from where it stopped once the limit is raised (the runner keeps the checkpoint).
-  double time_limit = scene.wall_time_limit;
-  if (ctx.time_limit_s() > 0) time_limit = time_limit > 0 ? std::min(time_limit, ctx.time_limit_s()) : ctx.time_limit_s();
-  scene.wall_time_limit = 0.0;
-  CaseObserver observer(ctx, time_limit);
-  RunSummary r = run_scene(scene, &observer);
-
-  CaseOutcome out;
-  if (r.stop_reason == "cancelled" && observer.timed_out()) {
+  // The shorter of the scene's run.wall_time_limit and the case's time limit. The engine saves
+  // the checkpoint when it fires and leaves the limit out of the checkpoint's scene, so a case
+  // that ran out of time continues from where it stopped once the limit is raised (the runner
+  // keeps the checkpoint).
+  if (ctx.time_limit_s() > 0)
+    scene.wall_time_limit =
+        scene.wall_time_limit > 0 ? std::min(scene.wall_time_limit, ctx.time_limit_s()) : ctx.time_limit_s();
+  CaseObserver observer(ctx);
+  RunSummary r;
+  try {
+    r = run_scene(scene, &observer);
+  } catch (const TimeLimitError& e) {
+    CaseOutcome out;
     out.cancelled = true;
     char what[200];
-    if (observer.settled())
+    if (e.settled)
       std::snprintf(what, sizeof what, "time limit: %g s (run.wall_time_limit or the case time limit) reached at t = %.1f s (%.0f%% done)",
-                    time_limit, r.sim_time_s, 100.0 * observer.fraction());
+                    e.limit_s, e.sim_time_s, 100.0 * e.fraction_done);
     else
       std::snprintf(what, sizeof what, "time limit: %g s (run.wall_time_limit or the case time limit) reached while settling",
-                    time_limit);
+                    e.limit_s);
     out.out_of_time = what;
     return out;
   }
+
+  CaseOutcome out;
   if (r.stop_reason == "cancelled") {
     out.cancelled = true;
     return out;
@@ -135,14 +128,21 @@ CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx) {
     throw SimulationError(std::string("measurement of the final snapshot failed: ") + e.what());
   }
   if (!ctx.views_dir().empty()) {
-    std::filesystem::create_directories(ctx.views_dir());
     char stem[32];
     std::snprintf(stem, sizeof stem, "case_%03zu_", study_case.index);
-    write_case_views(study_case.scene, r.final_snapshot, *out.measurement, ctx.views_dir(), stem);
-    if (ctx.keep_particles())
-      write_particle_file(ctx.views_dir() / (std::string(stem) + "particles.bin"), r.final_snapshot,
-                          particle_file_metadata(study_case.scene, ctx.measurement(), study_case.case_id,
-                                                 study_case.label));
+    // The side files are a view of the result, not the result: one that cannot be written (a
+    // full disk) is reported, and the case's measurement is stored all the same.
+    try {
+      std::filesystem::create_directories(ctx.views_dir());
+      write_case_views(study_case.scene, r.final_snapshot, *out.measurement, ctx.views_dir(), stem);
+      if (ctx.keep_particles())
+        write_particle_file(ctx.views_dir() / (std::string(stem) + "particles.bin"), r.final_snapshot,
+                            particle_file_metadata(study_case.scene, ctx.measurement(), study_case.case_id,
+                                                   study_case.label));
+    } catch (const std::exception& e) {
+      ctx.warn(std::string("its side files in ") + ctx.views_dir().string() + " were not all written (" +
+               e.what() + "); its result is stored");
+    }
   }
   return out;
 }

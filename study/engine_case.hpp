@@ -5,9 +5,10 @@
 
 namespace crevasse {
 
-// Runs the engine (the runner's time limit becomes run.wall_time_limit; cancellation goes
-// through the engine's observer) and measures the final snapshot with ctx.measurement().
-// Throws SimulationError on instability, time limit or non-finite results.
+// Runs the engine (the case's time limit, when shorter, becomes run.wall_time_limit;
+// cancellation goes through the engine's observer) and measures the final snapshot with
+// ctx.measurement(). A case out of time comes back as CaseOutcome::out_of_time, its checkpoint
+// saved; throws SimulationError on instability or non-finite results.
 CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx);
 
 // What a kept particle file carries besides the particles (engine/particle_file.hpp): the case,

@@ -304,5 +304,42 @@ TEST(Checkpoint, CancelledRunResumesToTheUninterruptedResult) {
   EXPECT_FALSE(fs::exists(file)) << "the checkpoint of a finished run is deleted";
 }
 
+// A run stopped by run.wall_time_limit saves its checkpoint as it stops (none is due by the
+// interval here), and the same scene under a larger limit continues from it to the
+// uninterrupted result: the limit is not part of the scene a checkpoint belongs to.
+TEST(Checkpoint, ARunOutOfTimeSavesItsCheckpointAndContinuesUnderALargerLimit) {
+  nlohmann::json j = test::shipped_scene_json();
+  j["run"]["gate_length"] = 100.0;  // a few seconds of wall time
+  const SceneConfig scene = scene_from_json(j);
+  const RunSummary whole = run_scene(scene);
+  ASSERT_EQ(whole.stop_reason, "gate_length");
+
+  const fs::path file = scratch("out_of_time");
+  struct NoPeriodicCheckpoints : CheckpointingObserver {
+    using CheckpointingObserver::CheckpointingObserver;
+    double checkpoint_interval_s() const override { return 1e9; }
+  } limited_obs(file, 0);
+  SceneConfig limited = scene;
+  limited.wall_time_limit = 0.5;
+  double stopped_at = -1.0;
+  try {
+    run_scene(limited, &limited_obs);
+    FAIL() << "the run finished before its 0.5 s limit";
+  } catch (const TimeLimitError& e) {
+    EXPECT_EQ(e.limit_s, 0.5);
+    stopped_at = e.sim_time_s;
+  }
+  ASSERT_TRUE(fs::exists(file)) << "no checkpoint saved at the time limit";
+  ASSERT_GT(stopped_at, 0.0);
+  EXPECT_LT(stopped_at, whole.sim_time_s);
+
+  CheckpointingObserver resume(file, 0);
+  const RunSummary second = run_scene(scene, &resume);
+  EXPECT_TRUE(resume.warnings.empty()) << resume.warnings[0];
+  EXPECT_EQ(second.resumed_from_time_s, stopped_at);
+  EXPECT_EQ(second.stop_reason, "gate_length");
+  expect_same_state(whole.final_snapshot, second.final_snapshot);
+}
+
 }  // namespace
 }  // namespace crevasse

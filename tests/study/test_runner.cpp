@@ -7,6 +7,7 @@
 #include <mutex>
 #include <set>
 #include <thread>
+#include <vector>
 
 #include "engine/error.hpp"
 #include "study/runner.hpp"
@@ -249,6 +250,32 @@ TEST(Runner, RealTinySimulationsAreStoredWithTheirMeasurements) {
   o2.jobs = 1;
   run_study(study, o2);
   EXPECT_EQ(test::result_dump(dir / "s.db"), test::result_dump(dir / "t.db"));
+}
+
+// A side file that cannot be written (here its folder cannot be made: a regular file is in
+// the way, as a full disk would stop it) is a warning: the case's result is stored all the same.
+TEST(Runner, SideFilesThatCannotBeWrittenLeaveTheResultStored) {
+  test::ScratchDir dir("runner");
+  const Study study = test::parse(test::tiny_study(2, 300));
+  test::write_text(dir / "a_file", "x");
+  RunnerOptions o;
+  o.db_path = dir / "s.db";
+  o.jobs = 1;
+  o.threads_per_case = 1;
+  o.views_dir = dir / "a_file" / "views";
+  o.keep_particles = true;
+  std::mutex m;
+  std::vector<std::string> warnings;
+  o.warn = [&](const std::string& w) {
+    std::lock_guard<std::mutex> lock(m);
+    warnings.push_back(w);
+  };
+  const RunnerReport r = run_study(study, o);
+  EXPECT_EQ(r.done, 2u) << r.first_failure;
+  EXPECT_EQ(r.failed, 0u);
+  ASSERT_EQ(warnings.size(), 2u);
+  for (const auto& w : warnings) EXPECT_NE(w.find("its result is stored"), std::string::npos) << w;
+  EXPECT_EQ(test::dump_rows(dir / "s.db", "SELECT count(*) FROM summaries")[0], "2");
 }
 
 }  // namespace
