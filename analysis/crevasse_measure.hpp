@@ -60,9 +60,10 @@ struct MeasureSettings {
   // rows under the surface cannot be told from an opening at this resolution): not counted,
   // and counted in shallow_count instead. 0 counts every surface-reaching cluster.
   double min_depth_over_dx = 3.0;
-  // Damaged particles closer than this belong to one crevasse; 1.5 spacings links axial and
-  // diagonal lattice neighbours but not particles across a one-particle intact gap.
-  double link_distance_over_spacing = 1.5;
+  // Damaged particles closer than this belong to one crevasse. 2.1 spacings also links across
+  // one particle, intact or gone, in a line of damage: an opened fracture is such a broken line,
+  // and its measured depth is the same from 2.1 to 3 spacings (docs/measurement.md, step 3).
+  double link_distance_over_spacing = 2.1;
   // A damaged cluster is a crevasse when one of its particles comes this close to z_s(x).
   double surface_reach_over_dx = 1.5;
   // Surface profile: moving average over this many dx-bins (odd; 1 = none), and dips narrower

@@ -5,12 +5,14 @@
 #include <algorithm>
 #include <atomic>
 #include <csignal>
+#include <memory>
 #include <cstdio>
 #include <thread>
 
 #include "cli/cli_common.hpp"
 #include "cli/progress_printer.hpp"
 #include "engine/error.hpp"
+#include "study/kept_runs.hpp"
 #include "study/runner.hpp"
 #include "study/shard.hpp"
 #include "study/study_file.hpp"
@@ -146,6 +148,9 @@ int study_command(const StudyCommandOptions& opt) {
     return 0;
   }
 
+  if (opt.remeasure_db.empty() != opt.particles_from.empty())
+    throw InputError(opt.remeasure_db.empty() ? "--particles-from: give the kept study's database with --remeasure DB too"
+                                              : "--remeasure: give the folder of its kept particles with --particles-from DIR too");
   if (opt.keep_particles && opt.views_dir.empty())
     throw InputError("--keep-particles: the particles are kept beside the side views; give --views DIR too");
   if (!opt.views_dir.empty()) {
@@ -186,6 +191,10 @@ int study_command(const StudyCommandOptions& opt) {
   ro.command = opt.command_line;
   ro.views_dir = opt.views_dir;
   ro.keep_particles = opt.keep_particles;
+  if (!opt.remeasure_db.empty()) {
+    auto kept = std::make_shared<const KeptRuns>(opt.remeasure_db, opt.particles_from);
+    ro.case_function = [kept](const StudyCase& c, CaseContext& ctx) { return (*kept)(c, ctx); };
+  }
   ro.observer = opt.quiet ? nullptr : &console;
   // Shown even with --quiet: a warning says that work may have to be redone.
   ro.warn = [&console](const std::string& m) { console.warn(m); };

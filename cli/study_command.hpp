@@ -18,6 +18,10 @@ struct StudyCommandOptions {
   bool quiet = false;
   std::string views_dir;  // non-empty: side views of every case run, case_NNN_side_view.png
   bool keep_particles = false;  // also case_NNN_particles.bin in views_dir
+  // Both or neither: measure the cases from the particles another study kept, with that
+  // study's database for the runs' records, instead of simulating them (study/kept_runs.hpp).
+  std::string remeasure_db;
+  std::string particles_from;
   std::string command_line;  // recorded in the sessions table
 };
 

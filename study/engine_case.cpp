@@ -58,6 +58,47 @@ nlohmann::json particle_file_metadata(const SceneConfig& scene, const analysis::
           {"measurement", measure_settings_to_json(measurement)}};
 }
 
+void measure_final_state(const StudyCase& study_case, CaseContext& ctx, const ParticleSnapshot& final_snapshot,
+                         CaseOutcome& out) {
+  try {
+    out.measurement = analysis::measure_crevasses(final_snapshot, ctx.measurement());
+    // The other spacing rule on the same snapshot, so that both are reported
+    // (docs/measurement.md, "The source study's rule"): result_json.other_spacing_rule.
+    analysis::MeasureSettings other = ctx.measurement();
+    other.spacing_rule = other.spacing_rule == "merge" ? "drop" : "merge";
+    const analysis::CrevasseMeasurement alt = analysis::measure_crevasses(final_snapshot, other);
+    nlohmann::json depths = nlohmann::json::array();
+    for (const auto& c : alt.crevasses) depths.push_back(c.depth_m);
+    out.result_extra["other_spacing_rule"] = {
+        {"spacing_rule", other.spacing_rule},
+        {"crevasse_count", alt.crevasses.size()},
+        {"spacings_m", alt.spacings_m},
+        {"depths_m", depths},
+        {"dropped_spacing_count", alt.dropped_spacing_count},
+        {"spacing_median_m", alt.spacing_m ? nlohmann::json(alt.spacing_m->median) : nlohmann::json()},
+        {"depth_median_m", alt.depth_m ? nlohmann::json(alt.depth_m->median) : nlohmann::json()}};
+  } catch (const std::invalid_argument& e) {
+    throw SimulationError(std::string("measurement of the final snapshot failed: ") + e.what());
+  }
+  if (!ctx.views_dir().empty()) {
+    char stem[32];
+    std::snprintf(stem, sizeof stem, "case_%03zu_", study_case.index);
+    // The side files are a view of the result, not the result: one that cannot be written (a
+    // full disk) is reported, and the case's measurement is stored all the same.
+    try {
+      std::filesystem::create_directories(ctx.views_dir());
+      write_case_views(study_case.scene, final_snapshot, *out.measurement, ctx.views_dir(), stem);
+      if (ctx.keep_particles())
+        write_particle_file(ctx.views_dir() / (std::string(stem) + "particles.bin"), final_snapshot,
+                            particle_file_metadata(study_case.scene, ctx.measurement(), study_case.case_id,
+                                                   study_case.label));
+    } catch (const std::exception& e) {
+      ctx.warn(std::string("its side files in ") + ctx.views_dir().string() + " were not all written (" +
+               e.what() + "); its result is stored");
+    }
+  }
+}
+
 CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx) {
   SceneConfig scene = study_case.scene;
   scene.vtu_interval = 0.0;
@@ -107,43 +148,7 @@ CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx) {
                   {"stage_seconds", r.stage_seconds},
                   {"particle_steps_per_s",
                    r.wall_s > 0 ? static_cast<double>(r.particle_steps) / r.wall_s : 0.0}};
-  try {
-    out.measurement = analysis::measure_crevasses(r.final_snapshot, ctx.measurement());
-    // The other spacing rule on the same snapshot, so that both are reported
-    // (docs/measurement.md, "The source study's rule"): result_json.other_spacing_rule.
-    analysis::MeasureSettings other = ctx.measurement();
-    other.spacing_rule = other.spacing_rule == "merge" ? "drop" : "merge";
-    const analysis::CrevasseMeasurement alt = analysis::measure_crevasses(r.final_snapshot, other);
-    nlohmann::json depths = nlohmann::json::array();
-    for (const auto& c : alt.crevasses) depths.push_back(c.depth_m);
-    out.result_extra["other_spacing_rule"] = {
-        {"spacing_rule", other.spacing_rule},
-        {"crevasse_count", alt.crevasses.size()},
-        {"spacings_m", alt.spacings_m},
-        {"depths_m", depths},
-        {"dropped_spacing_count", alt.dropped_spacing_count},
-        {"spacing_median_m", alt.spacing_m ? nlohmann::json(alt.spacing_m->median) : nlohmann::json()},
-        {"depth_median_m", alt.depth_m ? nlohmann::json(alt.depth_m->median) : nlohmann::json()}};
-  } catch (const std::invalid_argument& e) {
-    throw SimulationError(std::string("measurement of the final snapshot failed: ") + e.what());
-  }
-  if (!ctx.views_dir().empty()) {
-    char stem[32];
-    std::snprintf(stem, sizeof stem, "case_%03zu_", study_case.index);
-    // The side files are a view of the result, not the result: one that cannot be written (a
-    // full disk) is reported, and the case's measurement is stored all the same.
-    try {
-      std::filesystem::create_directories(ctx.views_dir());
-      write_case_views(study_case.scene, r.final_snapshot, *out.measurement, ctx.views_dir(), stem);
-      if (ctx.keep_particles())
-        write_particle_file(ctx.views_dir() / (std::string(stem) + "particles.bin"), r.final_snapshot,
-                            particle_file_metadata(study_case.scene, ctx.measurement(), study_case.case_id,
-                                                   study_case.label));
-    } catch (const std::exception& e) {
-      ctx.warn(std::string("its side files in ") + ctx.views_dir().string() + " were not all written (" +
-               e.what() + "); its result is stored");
-    }
-  }
+  measure_final_state(study_case, ctx, r.final_snapshot, out);
   return out;
 }
 

@@ -11,6 +11,12 @@ namespace crevasse {
 // saved; throws SimulationError on instability or non-finite results.
 CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx);
 
+// Measures a case's final state into `out` with ctx.measurement(), and under the other spacing
+// rule too (result_extra.other_spacing_rule), and writes its side files when ctx asks for them.
+// Throws SimulationError when the measurement fails.
+void measure_final_state(const StudyCase& study_case, CaseContext& ctx, const ParticleSnapshot& final_snapshot,
+                         CaseOutcome& out);
+
 // What a kept particle file carries besides the particles (engine/particle_file.hpp): the case,
 // ρ_i and g (for Π), and the study's measurement settings, which `crevasse measure` starts from.
 nlohmann::json particle_file_metadata(const SceneConfig& scene, const analysis::MeasureSettings& measurement,

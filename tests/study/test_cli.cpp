@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <regex>
@@ -487,6 +488,68 @@ TEST(Cli, StudyKeepsParticlesThatMeasureAsStored) {
     damaged += c.at("damaged_particles").get<std::int64_t>();
   }
   EXPECT_GT(damaged, 0) << "nothing was damaged: the comparison shows little; run the cases longer";
+}
+
+// A study that differs from a finished one only in its measurement can be measured from the
+// particles that study kept (`--remeasure DB --particles-from DIR`) instead of simulating it
+// again, and it stores exactly what a full run stores: the same case ids, records, result
+// hashes, crevasses and summaries. A case whose scene has no kept particles fails with the
+// reason, and the options are checked before any work.
+TEST(Cli, RemeasureFromKeptParticlesStoresWhatAFullRunStores) {
+  test::ScratchDir dir("cli");
+  nlohmann::json kept = test::tiny_study(2, 200, "kept");
+  kept["base_scene"]["run"] = {{"end_time", 30.0}};  // long enough for some ice to break
+  kept["measurement"] = {{"link_distance_over_spacing", 1.5}};
+  test::write_text(dir / "kept.json", kept.dump(2));
+  ASSERT_EQ(run_cli(dir.path(), "study kept.json --db kept.db --views v --keep-particles --quiet").code, 0);
+
+  nlohmann::json other = kept;
+  other["name"] = "other";
+  other["measurement"] = {{"link_distance_over_spacing", 2.5}, {"min_depth_over_dx", 1.0}};
+  test::write_text(dir / "other.json", other.dump(2));
+  const Result again = run_cli(dir.path(), "study other.json --db again.db --remeasure kept.db --particles-from v --views w --quiet");
+  ASSERT_EQ(again.code, 0) << again.err;
+  ASSERT_EQ(run_cli(dir.path(), "study other.json --db full.db --quiet").code, 0);
+  auto results = [&](const char* db) {
+    std::vector<std::string> all;
+    for (const char* sql : {"SELECT case_id, case_index, status, stop_reason, steps, particle_steps, sim_time_s, "
+                            "result_json, result_hash FROM cases ORDER BY case_id",
+                            "SELECT * FROM crevasses ORDER BY case_id, crevasse_index",
+                            "SELECT * FROM summaries ORDER BY case_id"}) {
+      const auto rows = test::dump_rows(dir / db, sql);
+      all.insert(all.end(), rows.begin(), rows.end());
+    }
+    return all;
+  };
+  EXPECT_EQ(results("again.db"), results("full.db"));
+  EXPECT_NE(results("kept.db"), results("full.db")) << "the settings changed nothing: the test shows nothing";
+  EXPECT_EQ(test::dump_rows(dir / "again.db", "SELECT count(*) FROM cases WHERE json_extract(run_json, "
+                                               "'$.measured_from.database') = 'kept.db'")[0], "2");
+  EXPECT_TRUE(std::filesystem::exists(dir / "w" / "case_001_side_view.png"));
+
+  // Another scene: nothing kept for it, so its cases fail and say why.
+  nlohmann::json longer = other;
+  longer["name"] = "longer";
+  longer["base_scene"]["run"] = {{"end_time", 31.0}};
+  test::write_text(dir / "longer.json", longer.dump(2));
+  const Result none = run_cli(dir.path(), "study longer.json --db longer.db --remeasure kept.db --particles-from v --quiet");
+  EXPECT_EQ(none.code, 1) << none.err;
+  const auto reasons = test::dump_rows(dir / "longer.db", "SELECT failure_reason FROM cases");
+  ASSERT_EQ(reasons.size(), 2u);
+  for (const auto& r : reasons) EXPECT_NE(r.find("no particles kept"), std::string::npos) << r;
+
+  auto refused = [&](const std::string& args, const std::string& names) {
+    const Result r = run_cli(dir.path(), args);
+    EXPECT_EQ(r.code, 2) << args << ": " << r.err;
+    EXPECT_NE(r.err.find(names), std::string::npos) << args << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << ": " << r.err;
+  };
+  refused("study other.json --db x.db --remeasure kept.db --quiet", "--remeasure");
+  refused("study other.json --db x.db --particles-from v --quiet", "--particles-from");
+  refused("study other.json --db x.db --remeasure nothing.db --particles-from v --quiet", "nothing.db");
+  std::filesystem::create_directories(dir / "empty");
+  refused("study other.json --db x.db --remeasure kept.db --particles-from empty --quiet", "empty");
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.db")) << "refused, yet the study began";
 }
 
 }  // namespace
