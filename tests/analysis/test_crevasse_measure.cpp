@@ -135,6 +135,46 @@ TEST(MeasureBuried, DamageThatDoesNotReachTheSurfaceIsNotACrevasse) {
   EXPECT_NEAR(m.crevasses[0].depth_m, 50.0, spec.dx_m);
 }
 
+// An opened fracture is a line of damage broken by intact particles and empty gaps. The default
+// link (2.1 particle spacings) bridges one particle, so two broken columns, 150 and 90 m deep,
+// are measured to their bottoms within one cell; a link of 1.5 spacings (lattice neighbours
+// only) stops each at its first break, above the 3·dx depth floor, and sees no crevasse.
+TEST(MeasureBrokenLine, AFractureBrokenByOneParticleIsMeasuredToItsBottom) {
+  SlabSpec spec;
+  spec.thickness_m = 200.0;
+  ParticleSnapshot s = make_slab(spec, {{.x_m = 600.0, .depth_m = 150.0}, {.x_m = 1200.0, .depth_m = 90.0}});
+  const double h = test::spacing_of(spec);
+  std::vector<std::size_t> keep;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const int row = static_cast<int>(std::floor((spec.thickness_m - s.z[i]) / h));  // 0 at the surface
+    const bool in_line = s.eps_v_p[i] > 0.0;
+    if (in_line && row % 4 == 2) s.eps_v_p[i] = 0.0;  // an intact particle every 20 m
+    if (!(in_line && row % 8 == 4)) keep.push_back(i);  // and one gone between them every 40 m
+  }
+  ParticleSnapshot broken = s;
+  for (auto* v : {&broken.x, &broken.y, &broken.z, &broken.vx, &broken.vy, &broken.vz, &broken.eps_v_p,
+                  &broken.pressure_pa, &broken.von_mises_pa, &broken.sigma_zz_pa, &broken.volume_m3}) {
+    const std::vector<double> all = *v;
+    if (all.empty()) continue;
+    v->clear();
+    for (std::size_t i : keep) v->push_back(all[i]);
+  }
+  ASSERT_LT(broken.size(), s.size());
+  const CrevasseMeasurement m = measure_crevasses(broken);
+  ASSERT_EQ(m.crevasses.size(), 2u);
+  EXPECT_NEAR(m.crevasses[0].x_m, 600.0, spec.dx_m);
+  EXPECT_NEAR(m.crevasses[0].depth_m, 150.0, spec.dx_m);
+  EXPECT_NEAR(m.crevasses[1].x_m, 1200.0, spec.dx_m);
+  EXPECT_NEAR(m.crevasses[1].depth_m, 90.0, spec.dx_m);
+
+  MeasureSettings neighbours_only;
+  neighbours_only.link_distance_over_spacing = 1.5;
+  const CrevasseMeasurement short_link = measure_crevasses(broken, neighbours_only);
+  EXPECT_EQ(short_link.crevasses.size(), 0u);
+  EXPECT_EQ(m.cluster_count, 2u);
+  EXPECT_EQ(short_link.cluster_count, 12u + 7u) << "one cluster per unbroken strand";
+}
+
 // A lens one or two particle rows under an intact surface row (the strong-ice case of the
 // flowing glacier's hand count, docs/measurement.md) and a notch 20 m deep both reach the
 // surface but are shallower than the 3·dx = 30 m depth floor: counted as shallow, not as
