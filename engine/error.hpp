@@ -1,5 +1,5 @@
 #pragma once
-// The ways a case can fail. Both carry a message a user can act on; the CLI prints it on
+// The ways a case can fail. Each carries a message a user can act on; the CLI prints it on
 // one line and maps InputError to exit code 2.
 #include <stdexcept>
 #include <string>
