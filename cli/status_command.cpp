@@ -91,16 +91,20 @@ int status_command(const StatusCommandOptions& opt) {
         db,
         "SELECT c.case_index, substr(c.case_id, 1, 10), c.thickness_m, c.cohesion_ratio, "
         "c.step_length_ratio, "
-        "c.slope, m.crevasse_count, m.spacing_median_over_h, m.depth_median_over_h, c.wall_s, "
+        "c.slope, m.crevasse_count, m.spacing_median_over_h, m.depth_median_over_h, "
+        // A case measured again from kept particles shows the wall time of the run that made them.
+        "CASE WHEN json_extract(c.run_json, '$.measured_from') IS NULL THEN c.wall_s "
+        "ELSE json_extract(c.run_json, '$.engine_wall_s') END, "
         "c.label, "
         "m.fragmented, " +
             store.under_resolved_column() +
-            ", 100.0 * json_extract(c.result_json, '$.measurement.damage.deep_damaged_fraction')"
+            ", 100.0 * json_extract(c.result_json, '$.measurement.damage.deep_damaged_fraction'), "
+            "json_extract(c.run_json, '$.measured_from') IS NOT NULL"
             " FROM cases c LEFT JOIN summaries m USING (case_id) WHERE c.status = 'done' "
             "ORDER BY c.case_index LIMIT ?");
     s.bind(1, static_cast<std::int64_t>(limit));
     while (s.step()) {
-      std::printf("  %5lld  %-10s %8s %8s %8s %7s  %5lld %9s %9s %5s %8s  %s%s%s\n",
+      std::printf("  %5lld  %-10s %8s %8s %8s %7s  %5lld %9s %9s %5s %8s  %s%s%s%s\n",
                   static_cast<long long>(s.integer(0)), s.text(1).c_str(),
                   cell(s, 2, "%.0f").c_str(), cell(s, 3, "%.4g").c_str(),
                   cell(s, 4, "%.3g").c_str(), cell(s, 5, "%.3g").c_str(),
@@ -109,7 +113,8 @@ int status_command(const StatusCommandOptions& opt) {
                   format_wall_time(s.real(9)).c_str(),
                   s.text(10).c_str(),
                   s.integer(11) ? "  (fragmented)" : "",
-                  s.integer(12) ? "  (under-resolved: c/(rho_i g) < 3 dx)" : "");
+                  s.integer(12) ? "  (under-resolved: c/(rho_i g) < 3 dx)" : "",
+                  s.integer(14) ? "  (measured again from kept particles; wall: the run's)" : "");
     }
     if (limit >= 0 && c.done > limit)
       std::printf("  ... %lld more (crevasse status --all, or crevasse export --csv)\n",

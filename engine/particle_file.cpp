@@ -213,4 +213,33 @@ ParticleFile read_particle_file(const std::filesystem::path& path) {
   return out;
 }
 
+nlohmann::json read_particle_file_metadata(const std::filesystem::path& path) {
+  const std::string where = path.string();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw InputError(where + ": no such particle file (a regular file)");
+  std::ifstream f(path, std::ios::binary);
+  char magic[sizeof kMagic];
+  std::uint32_t format = 0;
+  std::uint64_t header_size = 0;
+  if (!f.read(magic, sizeof magic) || std::memcmp(magic, kMagic, sizeof kMagic) != 0)
+    throw InputError(where + ": not a crevasse particle file");
+  if (!f.read(reinterpret_cast<char*>(&format), sizeof format) ||
+      !f.read(reinterpret_cast<char*>(&header_size), sizeof header_size))
+    throw InputError(where + ": truncated particle file");
+  if (format != kFormat)
+    throw InputError(where + ": particle file format " + std::to_string(format) +
+                     " (this crevasse reads format " + std::to_string(kFormat) + ")");
+  const auto file_size = std::filesystem::file_size(path, ec);
+  if (ec || header_size > file_size) throw InputError(where + ": truncated particle file");
+  std::string header_text(header_size, '\0');
+  if (!f.read(header_text.data(), static_cast<std::streamsize>(header_size)))
+    throw InputError(where + ": truncated particle file");
+  try {
+    return nlohmann::json::parse(header_text).at("metadata");
+  } catch (const std::exception& e) {
+    throw InputError(where + ": damaged particle file (" + e.what() + ")");
+  }
+}
+
 }  // namespace crevasse

@@ -30,4 +30,9 @@ struct ParticleFile {
 // truncated or damaged (the arrays carry a CRC-32 and their lengths are checked).
 ParticleFile read_particle_file(const std::filesystem::path& path);
 
+// The metadata alone, read from the header without touching the particles: what a caller that
+// only sorts files needs. InputError as above for a file that is not a particle file of this
+// format; damage in the arrays is found only by read_particle_file.
+nlohmann::json read_particle_file_metadata(const std::filesystem::path& path);
+
 }  // namespace crevasse

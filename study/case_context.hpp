@@ -41,9 +41,9 @@ class CaseContext {
   int threads() const { return threads_; }
   double time_limit_s() const { return time_limit_s_; }  // 0 = none
   const analysis::MeasureSettings& measurement() const { return measurement_; }
+  // For a case function without a clock of its own: it stops and says so in
+  // CaseOutcome::out_of_time. The runner takes a cancelled case without it as stopped.
   bool time_limit_exceeded() const;
-  // The runner's stop signal, or the time limit for a case function that has no clock of its own.
-  bool should_stop() const { return stop_requested() || time_limit_exceeded(); }
   bool stop_requested() const { return stop_.load(); }
   void report_fraction(double f) { fraction_.store(f); }
   double elapsed_s() const;

@@ -26,8 +26,8 @@ KeptRuns::KeptRuns(std::filesystem::path db, const std::filesystem::path& partic
   }
   std::sort(paths.begin(), paths.end());
   for (const auto& p : paths) {
-    // Only the metadata is kept; the particles are read again by the case that uses them.
-    const nlohmann::json meta = read_particle_file(p).metadata;
+    // The particles are read by the case that uses them.
+    const nlohmann::json meta = read_particle_file_metadata(p);
     if (!meta.contains("case_id") || !meta.contains("measurement") || !meta.contains("engine_version"))
       continue;  // not written by a study
     files_.push_back({p, meta.at("case_id").get<std::string>(), meta.at("engine_version").get<std::string>(),

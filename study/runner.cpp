@@ -17,6 +17,7 @@
 #include "analysis/measurement_io.hpp"
 #include "engine/error.hpp"
 #include "study/engine_case.hpp"
+#include "study/eta.hpp"
 #include "study/memory_reserve.hpp"
 
 namespace crevasse {
@@ -117,52 +118,6 @@ int default_jobs(int threads_per_case) {
 }
 
 namespace {
-
-// How long the cases still to run will take: the mean wall time of the cases finished so far,
-// or, before any has finished, what the running ones project from their progress.
-class EtaEstimator {
- public:
-  EtaEstimator(const std::vector<std::atomic<double>>& fraction, int jobs) : fraction_(fraction), jobs_(jobs) {}
-  void started(std::size_t slot) { running_[slot] = clock_type::now(); }
-  void stopped(std::size_t slot) { running_.erase(slot); }
-  void finished(std::size_t slot, double wall_s) {
-    running_.erase(slot);
-    finished_walls_.push_back(wall_s);
-  }
-  std::size_t running() const { return running_.size(); }
-
-  std::optional<double> eta(std::size_t pending) const {
-    double per_case = 0.0;
-    if (!finished_walls_.empty()) {
-      for (double w : finished_walls_) per_case += w;
-      per_case /= static_cast<double>(finished_walls_.size());
-    } else {
-      int n = 0;
-      for (const auto& [slot, start] : running_) {
-        const double f = fraction_[slot].load();
-        if (f > 0.02) {
-          per_case += seconds_since(start) / f;
-          ++n;
-        }
-      }
-      if (n == 0) return std::nullopt;
-      per_case /= n;
-    }
-    double remaining = static_cast<double>(pending) * per_case;
-    for (const auto& [slot, start] : running_) {
-      const double f = fraction_[slot].load();
-      const double total = f > 0.02 ? seconds_since(start) / f : per_case;
-      remaining += std::max(0.0, total - seconds_since(start));
-    }
-    return remaining / jobs_;
-  }
-
- private:
-  const std::vector<std::atomic<double>>& fraction_;
-  int jobs_;
-  std::map<std::size_t, clock_type::time_point> running_;
-  std::vector<double> finished_walls_;
-};
 
 // One run of a study: set up (everything that can refuse the run does so before a case
 // starts), the workers that run one case at a time each, and the writer loop on the calling
@@ -340,14 +295,15 @@ class StudyRun {
     // other cases go on.
     if (!failure.empty()) rearm_memory_reserve();
     bool out_of_time = false;
+    // Only the case knows whether it stopped for its clock or for the stop signal: a stop
+    // that arrives after the limit has passed is still a stop, and the case stays pending.
     if (failure.empty() && outcome.cancelled) {
-      if (!outcome.out_of_time && !ctx.time_limit_exceeded()) {
+      if (!outcome.out_of_time) {
         queue_.push(Event{Event::Kind::cancelled, slot, {}, started_at});
         return;
       }
       out_of_time = true;
-      failure = outcome.out_of_time.value_or("time limit: the case ran longer than the case time limit of " +
-                                             std::to_string(time_limit_) + " s");
+      failure = *outcome.out_of_time;
     }
     // A case out of time keeps its checkpoint, to continue from under a larger limit; any other
     // end is final: nothing to continue from.
@@ -389,11 +345,12 @@ class StudyRun {
   // are done. Returns the first error of the store (the run then stops).
   std::exception_ptr write_events(int jobs) {
     std::exception_ptr writer_error;
-    EtaEstimator eta(fraction_, jobs);
+    EtaEstimator eta(jobs);
     const auto update_progress = [&] {
       progress_.running = eta.running();
       progress_.elapsed_s = seconds_since(t0_);
-      progress_.eta_s = eta.eta(progress_.pending);
+      progress_.eta_s = eta.eta(
+          progress_.pending, [&](std::size_t slot) { return fraction_[slot].load(); }, progress_.elapsed_s);
     };
     bool closed = false;
     while (!closed) {
@@ -406,7 +363,7 @@ class StudyRun {
           switch (e.kind) {
             case Event::Kind::started:
               store_.mark_running(c.case_id, report_.session_id, e.started_at, report_.threads_per_case);
-              eta.started(e.slot);
+              eta.started(e.slot, seconds_since(t0_));
               --progress_.pending;
               break;
             case Event::Kind::warning:

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -77,6 +79,7 @@ void round_trip(int dim) {
   const nlohmann::json meta = {{"case_id", "abc"}, {"density_kg_m3", 917.0}, {"measurement", {{"frame", "passed"}}}};
   write_particle_file(path, s, meta);
   const ParticleFile f = read_particle_file(path);
+  EXPECT_EQ(read_particle_file_metadata(path), meta);
   std::filesystem::remove(path);
   const ParticleSnapshot& r = f.snapshot;
   EXPECT_EQ(f.metadata, meta);
@@ -131,6 +134,19 @@ TEST(ParticleFile, TruncatedDamagedAndForeignFilesAreRefused) {
   ASSERT_GT(whole.size(), 100u);
   // Every cut, in steps small enough to land in each part (magic, header, sizes, payload, end).
   for (std::size_t cut = 0; cut < whole.size(); cut += 7) expect_refused(path, whole.substr(0, cut), "cut file");
+  // The header alone (magic, format, its size, its JSON): refused when cut inside it, read
+  // whole when the cut falls in the arrays, which only read_particle_file checks.
+  std::uint64_t header_size = 0;
+  std::memcpy(&header_size, whole.data() + 12, sizeof header_size);
+  const std::size_t header_end = 20 + header_size;
+  ASSERT_LT(header_end, whole.size());
+  for (std::size_t cut = 0; cut < whole.size(); cut += 7) {
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << whole.substr(0, cut);
+    if (cut < header_end)
+      EXPECT_THROW(read_particle_file_metadata(path), InputError) << "cut at " << cut;
+    else
+      EXPECT_NO_THROW(read_particle_file_metadata(path)) << "cut at " << cut;
+  }
   expect_refused(path, whole + "x", "file with bytes after its end");
   // A byte flipped in the compressed arrays: zlib or the CRC-32 notices.
   for (std::size_t k : {whole.size() / 2, whole.size() - 20}) {

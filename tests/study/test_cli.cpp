@@ -526,6 +526,11 @@ TEST(Cli, RemeasureFromKeptParticlesStoresWhatAFullRunStores) {
   EXPECT_EQ(test::dump_rows(dir / "again.db", "SELECT count(*) FROM cases WHERE json_extract(run_json, "
                                                "'$.measured_from.database') = 'kept.db'")[0], "2");
   EXPECT_TRUE(std::filesystem::exists(dir / "w" / "case_001_side_view.png"));
+  const Result status = run_cli(dir.path(), "status again.db");
+  std::size_t marked = 0;
+  for (std::size_t at = 0; (at = status.out.find("measured again from kept particles", at)) != std::string::npos; ++at)
+    ++marked;
+  EXPECT_EQ(marked, 2u) << status.out;
 
   // Another scene: nothing kept for it, so its cases fail and say why.
   nlohmann::json longer = other;

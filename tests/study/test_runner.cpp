@@ -97,7 +97,7 @@ TEST(Runner, FailFastCancelsRunningCasesWhichStayPending) {
       std::this_thread::sleep_for(50ms);
       throw SimulationError("boom");
     }
-    while (!ctx.should_stop()) std::this_thread::sleep_for(5ms);  // a long case
+    while (!ctx.stop_requested()) std::this_thread::sleep_for(5ms);  // a long case
     CaseOutcome o;
     o.cancelled = true;
     return o;
@@ -118,9 +118,10 @@ TEST(Runner, ACaseOverItsTimeLimitFails) {
   const Study study = test::parse(test::tiny_study(3));
   auto fn = [](const StudyCase& c, CaseContext& ctx) {
     if (c.index != 1) return test::fake_outcome(c);
-    while (!ctx.should_stop()) std::this_thread::sleep_for(5ms);
+    while (!ctx.stop_requested() && !ctx.time_limit_exceeded()) std::this_thread::sleep_for(5ms);
     CaseOutcome o;
     o.cancelled = true;
+    if (ctx.time_limit_exceeded()) o.out_of_time = "time limit: over " + std::to_string(ctx.time_limit_s()) + " s";
     return o;
   };
   RunnerOptions o = fake_options(dir / "s.db", fn);
@@ -131,6 +132,29 @@ TEST(Runner, ACaseOverItsTimeLimitFails) {
   const auto reason =
       test::dump_rows(dir / "s.db", "SELECT failure_reason FROM cases WHERE case_index = 1").at(0);
   EXPECT_NE(reason.find("time limit"), std::string::npos) << reason;
+}
+
+// The case alone knows why it stopped: a stop signal that comes after the case's time limit
+// has passed, while the case had not yet looked at its clock, leaves it pending.
+TEST(Runner, AStopAfterTheTimeLimitPassedLeavesTheCasePending) {
+  test::ScratchDir dir("runner");
+  const Study study = test::parse(test::tiny_study(2));
+  auto fn = [](const StudyCase& c, CaseContext& ctx) {
+    if (c.index == 0) {
+      std::this_thread::sleep_for(300ms);
+      throw SimulationError("boom");  // fail-fast stops the other case, past its limit
+    }
+    while (!ctx.stop_requested()) std::this_thread::sleep_for(5ms);
+    CaseOutcome o;
+    o.cancelled = true;
+    return o;
+  };
+  RunnerOptions o = fake_options(dir / "s.db", fn, 2);
+  o.fail_fast = true;
+  o.case_time_limit_s = 0.1;
+  const RunnerReport r = run_study(study, o);
+  EXPECT_EQ(r.cancelled, 1u);
+  EXPECT_EQ(test::dump_rows(dir / "s.db", "SELECT status FROM cases WHERE case_index = 1").at(0), "pending");
 }
 
 TEST(Runner, CasesRunConcurrentlyUpToJobs) {
