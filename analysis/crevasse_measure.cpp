@@ -76,11 +76,12 @@ struct Candidate {
 
 bool uses_gate_frame(const ParticleSnapshot& snapshot, const MeasureSettings& settings) {
   require(settings.frame == "auto" || settings.frame == "gate" || settings.frame == "final" ||
-              settings.frame == "passed",
-          "frame must be 'auto', 'gate', 'final' or 'passed', got '" + settings.frame + "'");
-  if (settings.frame == "passed")
+              settings.frame == "passed" || settings.frame == "draped",
+          "frame must be 'auto', 'gate', 'final', 'passed' or 'draped', got '" + settings.frame + "'");
+  if (settings.frame == "passed" || settings.frame == "draped")
     require(snapshot.upstream_ice_front_x_m > 0.0 || snapshot.size() == 0,
-            "frame 'passed' needs a snapshot that knows where the ice came from (a slab scene with a gate)");
+            "frame '" + settings.frame +
+                "' needs a snapshot that knows where the ice came from (a slab scene with a gate)");
   if (settings.frame == "gate")
     require(snapshot.has_gate(), "frame 'gate' needs a snapshot with gate records (a slab on a "
                                  "step or concave bed, with plasticity)");
@@ -182,10 +183,15 @@ ResolvedMeasureSettings resolve_in_frame(const ParticleSnapshot& snapshot,
 
   const double margin = settings.window_margin_over_h * r.ice_thickness_m;
   r.window_explicit = settings.window_min_x_m.has_value() || settings.window_max_x_m.has_value();
-  r.frame = gate ? "gate" : settings.frame == "passed" ? "passed" : "final";
+  r.frame = gate ? "gate" : (settings.frame == "passed" || settings.frame == "draped") ? settings.frame : "final";
   if (r.frame == "passed") {
     r.window_min_x_m = settings.window_min_x_m.value_or(snapshot.step_top_x_m + margin);
     r.window_max_x_m = settings.window_max_x_m.value_or(snapshot.upstream_ice_front_x_m - margin);
+  } else if (r.frame == "draped") {
+    // The passed window stops margin·H_i short of the same point: the first ice over the lip,
+    // in between, is the start-up transient and belongs to neither.
+    r.window_min_x_m = settings.window_min_x_m.value_or(snapshot.upstream_ice_front_x_m);
+    r.window_max_x_m = settings.window_max_x_m.value_or(snapshot.front_x() - margin);
   } else if (gate) {
     r.window_min_x_m =
         settings.window_min_x_m.value_or(snapshot.gate_x_m - snapshot.gate_passed_length_m + margin);

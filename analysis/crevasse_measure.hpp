@@ -30,6 +30,9 @@ struct MeasureSettings {
   //            the step during the run: window [step_top_x + margin·H_i, front of the ice that
   //            started upstream of the top of the step − margin·H_i]. Where the field forms
   //            when the ice goes on cracking past the lip (docs/measurement.md).
+  //   "draped": the other ice past the step: what lay on the ramp and the floor at the start,
+  //            where it is at the end. Window [front of the ice that started upstream of the
+  //            top of the step, front − margin·H_i]. It cracks as it slides down the ramp.
   //   "auto":  "gate" when the snapshot has gate records, else "final".
   std::string frame = "auto";
 
@@ -89,7 +92,7 @@ struct MeasureSettings {
 
 // The numbers actually used, recorded with every result.
 struct ResolvedMeasureSettings {
-  std::string frame = "final";  // "gate", "final" or "passed"
+  std::string frame = "final";  // "gate", "final", "passed" or "draped"
   double damage_threshold = 0.0;
   double eps_v_p_threshold = 0.0;         // the ε_v^p at which a particle becomes damaged
   bool threshold_from_softening = false;  // false: the absolute ε_v^p threshold was used

@@ -269,9 +269,9 @@ analysis::MeasureSettings measure_settings_from_json(const json& j) {
   };
   if (o.contains("frame")) {
     const auto& f = o.at("frame");
-    if (!f.is_string() || (f != "auto" && f != "gate" && f != "final" && f != "passed"))
+    if (!f.is_string() || (f != "auto" && f != "gate" && f != "final" && f != "passed" && f != "draped"))
       fail("measurement.frame",
-           "value " + f.dump() + " is not \"auto\", \"gate\", \"final\" or \"passed\"");
+           "value " + f.dump() + " is not \"auto\", \"gate\", \"final\", \"passed\" or \"draped\"");
     s.frame = f.get<std::string>();
   }
   num("damage_threshold", s.damage_threshold, {0.0, 1.0, true, true});

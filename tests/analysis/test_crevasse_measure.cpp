@@ -278,6 +278,30 @@ TEST(MeasureWindow, PassedFrameEndsAtTheIceThatCameOverTheStep) {
   EXPECT_THROW(measure_crevasses(s, passed), std::invalid_argument);
 }
 
+// The "draped" frame measures the rest of the ice past the step, what lay there from the start:
+// from the front of the ice that started upstream of the step to half an H_i behind the front.
+TEST(MeasureWindow, DrapedFrameHoldsTheIceThatLayPastTheStepFromTheStart) {
+  SlabSpec spec;
+  const std::vector<Notch> notches = {{.x_m = 600.0, .depth_m = 30.0},
+                                      {.x_m = 1000.0, .depth_m = 30.0},
+                                      {.x_m = 1300.0, .depth_m = 30.0},
+                                      {.x_m = 1975.0, .depth_m = 30.0}};
+  ParticleSnapshot s = make_slab(spec, notches);
+  s.step_top_x_m = 100.0;
+  s.upstream_ice_front_x_m = 900.0;
+  MeasureSettings draped;
+  draped.frame = "draped";
+  const CrevasseMeasurement m = measure_crevasses(s, draped);
+  EXPECT_EQ(m.settings.frame, "draped");
+  EXPECT_DOUBLE_EQ(m.settings.window_min_x_m, 900.0);
+  EXPECT_DOUBLE_EQ(m.settings.window_max_x_m, s.front_x() - 0.5 * spec.thickness_m);
+  ASSERT_EQ(m.crevasses.size(), 2u);
+  EXPECT_NEAR(m.crevasses[0].x_m, 1000.0, spec.dx_m);
+  EXPECT_NEAR(m.crevasses[1].x_m, 1300.0, spec.dx_m);
+  s.upstream_ice_front_x_m = 0.0;
+  EXPECT_THROW(measure_crevasses(s, draped), std::invalid_argument);
+}
+
 // Damage every particle of `s` inside the box [x0, x1] × [z0, z1] (to the notches' ε_v^p).
 void damage_box(ParticleSnapshot& s, const SlabSpec& spec, double x0, double x1, double z0, double z1) {
   for (std::size_t p = 0; p < s.size(); ++p)
