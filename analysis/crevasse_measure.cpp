@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -74,10 +75,25 @@ struct Candidate {
 
 }  // namespace
 
+namespace {
+constexpr const char* kFrames[] = {"auto", "gate", "final", "passed", "draped"};
+}  // namespace
+
+bool is_measure_frame(const std::string& name) {
+  return std::find(std::begin(kFrames), std::end(kFrames), name) != std::end(kFrames);
+}
+
+std::string measure_frame_names() {
+  std::string out;
+  const std::size_t n = std::size(kFrames);
+  for (std::size_t i = 0; i < n; ++i)
+    out += (i == 0 ? "" : i + 1 == n ? " or " : ", ") + std::string("'") + kFrames[i] + "'";
+  return out;
+}
+
 bool uses_gate_frame(const ParticleSnapshot& snapshot, const MeasureSettings& settings) {
-  require(settings.frame == "auto" || settings.frame == "gate" || settings.frame == "final" ||
-              settings.frame == "passed" || settings.frame == "draped",
-          "frame must be 'auto', 'gate', 'final', 'passed' or 'draped', got '" + settings.frame + "'");
+  require(is_measure_frame(settings.frame),
+          "frame must be " + measure_frame_names() + ", got '" + settings.frame + "'");
   if (settings.frame == "passed" || settings.frame == "draped")
     require(snapshot.upstream_ice_front_x_m > 0.0 || snapshot.size() == 0,
             "frame '" + settings.frame +

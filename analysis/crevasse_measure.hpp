@@ -180,6 +180,10 @@ CrevasseMeasurement measure_crevasses(const ParticleSnapshot& snapshot,
 // initial position with the ε_v^p it had at the gate (velocities and stresses zero). Metadata
 // (dx, H_i, ζ, bed, gate) copied; the front is the gate. Throws when there are no records.
 ParticleSnapshot gate_frame_snapshot(const ParticleSnapshot& snapshot);
+// The frame names MeasureSettings::frame accepts, and the same as one line for messages
+// ("'auto', 'gate', 'final', 'passed' or 'draped'"). Study files check their frame against it.
+bool is_measure_frame(const std::string& name);
+std::string measure_frame_names();
 // True when `settings` select the gate frame for this snapshot (throws on a bad frame name or
 // on "gate" without gate records).
 bool uses_gate_frame(const ParticleSnapshot& snapshot, const MeasureSettings& settings);

@@ -1,6 +1,6 @@
 // bench_case [STEPS] [THICKNESS] [STUDY]: the production case's throughput, as a study runs it.
-// The case is the one of STUDY (default studies/whole_case_cost.json, the flowing glacier at
-// dx = 10 m with the regime study's numerics) with that H_i (default 400 m), read through the
+// The case is the one of STUDY (default studies/whole_case_cost.json, the pushed glacier at
+// dx = 10 m as the decisive studies run it) with that H_i (default 400 m), read through the
 // study loader so that it is exactly the case the study runs. After one settling, saved and
 // reloaded from a checkpoint, it times STEPS steps (default 400):
 //   (a) one case on 1 and on 2 engine threads, in particle-steps per second, and how the

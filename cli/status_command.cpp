@@ -89,19 +89,18 @@ int status_command(const StatusCommandOptions& opt) {
                 "H_i[m]", "Pi", "r=Ls/Hi", "S", "crev", "Lp/Hi", "Dp/Hi", "deep", "wall", "label");
     Statement s(
         db,
+        "WITH c AS (SELECT *, json_extract(run_json, '$.measured_from') IS NOT NULL AS remeasured "
+        "FROM cases WHERE status = 'done') "
         "SELECT c.case_index, substr(c.case_id, 1, 10), c.thickness_m, c.cohesion_ratio, "
         "c.step_length_ratio, "
         "c.slope, m.crevasse_count, m.spacing_median_over_h, m.depth_median_over_h, "
         // A case measured again from kept particles shows the wall time of the run that made them.
-        "CASE WHEN json_extract(c.run_json, '$.measured_from') IS NULL THEN c.wall_s "
-        "ELSE json_extract(c.run_json, '$.engine_wall_s') END, "
+        "CASE WHEN c.remeasured THEN json_extract(c.run_json, '$.engine_wall_s') ELSE c.wall_s END, "
         "c.label, "
         "m.fragmented, " +
             store.under_resolved_column() +
             ", 100.0 * json_extract(c.result_json, '$.measurement.damage.deep_damaged_fraction'), "
-            "json_extract(c.run_json, '$.measured_from') IS NOT NULL"
-            " FROM cases c LEFT JOIN summaries m USING (case_id) WHERE c.status = 'done' "
-            "ORDER BY c.case_index LIMIT ?");
+            "c.remeasured FROM c LEFT JOIN summaries m USING (case_id) ORDER BY c.case_index LIMIT ?");
     s.bind(1, static_cast<std::int64_t>(limit));
     while (s.step()) {
       std::printf("  %5lld  %-10s %8s %8s %8s %7s  %5lld %9s %9s %5s %8s  %s%s%s%s\n",

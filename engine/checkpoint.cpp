@@ -47,6 +47,7 @@ void save_checkpoint(const std::string& path, const SceneConfig& scene, const Ru
   ck::put(o, run.return_map_evaluations); ck::put(o, run.removed_mass); ck::put(o, run.front_x);
   ck::put(o, run.max_speed); ck::put(o, static_cast<std::uint8_t>(run.settled));
   ck::put(o, gate.passed_volume()); ck::put(o, run.inflow_mass); ck::put(o, run.inflow_columns);
+  ck::put(o, run.wall_s);
   ck::put_vector(o, P.x); ck::put_vector(o, P.v); ck::put_vector(o, P.C); ck::put_vector(o, P.F_e);
   ck::put_vector(o, P.tau); ck::put_vector(o, P.mass); ck::put_vector(o, P.vol0);
   ck::put_vector(o, P.eps_v_p); ck::put_vector(o, P.drive_x0); ck::put_vector(o, P.x_ref);
@@ -101,11 +102,10 @@ void load_checkpoint(const std::string& path, const SceneConfig& scene, RunCount
     if (!f) throw bad("truncated (it changed while being read)");
   }
   const char* end_magic = bytes.data() + bytes.size() - sizeof ck::kMagic;
-  if (!std::equal(ck::kMagic, ck::kMagic + sizeof ck::kMagic, bytes.data())) {
-    if (bytes.compare(0, 7, ck::kMagic, 7) == 0) throw bad("written in another checkpoint format");
-    throw bad("not a crevasse checkpoint");
-  }
-  if (!std::equal(ck::kMagic, ck::kMagic + sizeof ck::kMagic, end_magic)) throw bad("truncated");
+  if (bytes.compare(0, 7, ck::kMagic, 7) != 0) throw bad("not a crevasse checkpoint");
+  const char format = bytes[7];
+  if (format != ck::kMagic[7] && format != ck::kFormat2) throw bad("written in another checkpoint format");
+  if (!std::equal(bytes.data(), bytes.data() + sizeof ck::kMagic, end_magic)) throw bad("truncated");
   std::uint64_t stored_sum = 0;
   std::memcpy(&stored_sum, end_magic - sizeof stored_sum, sizeof stored_sum);
   const std::size_t payload_size = bytes.size() - sizeof ck::kMagic - kTail;
@@ -125,6 +125,7 @@ void load_checkpoint(const std::string& path, const SceneConfig& scene, RunCount
   ck::get(i, r.return_map_evaluations); ck::get(i, r.removed_mass); ck::get(i, r.front_x);
   ck::get(i, r.max_speed); ck::get(i, settled); ck::get(i, gate_volume);
   ck::get(i, r.inflow_mass); ck::get(i, r.inflow_columns);
+  if (format != ck::kFormat2) ck::get(i, r.wall_s);
   r.settled = settled != 0;
   Particles<Dim> P;
   const std::uint64_t kMax = payload_size;

@@ -25,6 +25,9 @@ struct RunCounters {
   bool settled = false;
   double inflow_mass = 0.0;
   std::int64_t inflow_columns = 0;
+  // Wall seconds the run had taken when the checkpoint was written, over all its sittings, so
+  // that a resumed run reports its whole cost. Format 2 files did not keep it: read as 0.
+  double wall_s = 0.0;
 };
 
 // Written atomically (temporary file, then rename); SimulationError when it cannot be, and then
@@ -44,8 +47,10 @@ void load_checkpoint(const std::string& path, const SceneConfig& scene, RunCount
 
 namespace crevasse::checkpoint {
 
-// Format 2 added the checksum.
-inline constexpr char kMagic[8] = {'C', 'R', 'V', 'C', 'K', 'P', 'T', '2'};
+// Format 2 added the checksum, format 3 the wall time (RunCounters::wall_s). Format 2 is still
+// read, so that a study paused before format 3 continues where it stopped.
+inline constexpr char kMagic[8] = {'C', 'R', 'V', 'C', 'K', 'P', 'T', '3'};
+inline constexpr char kFormat2 = '2';
 
 // 64-bit FNV-1a over 8-byte words (then the tail bytes): cheap next to writing the file, and
 // any flipped bit changes it.

@@ -126,38 +126,55 @@ void write_particle_file(const std::filesystem::path& path, const ParticleSnapsh
   write_file_atomically(path, out);
 }
 
-ParticleFile read_particle_file(const std::filesystem::path& path) {
-  const std::string where = path.string();
+namespace {
+
+// Opens a particle file and reads its prelude (magic, format, header size, header JSON text),
+// leaving the stream at the sizes that follow. Both readers share it, and so its refusals.
+std::string open_and_read_header(const std::filesystem::path& path, const std::string& where, std::ifstream& f) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     throw InputError(where + ": no such particle file (a regular file)");
-  std::ifstream f(path, std::ios::binary);
+  const auto file_size = std::filesystem::file_size(path, ec);
+  f.open(path, std::ios::binary);
+  if (ec || !f) throw InputError(where + ": cannot read the particle file");
+  char magic[sizeof kMagic];
+  if (!f.read(magic, sizeof magic) || std::memcmp(magic, kMagic, sizeof kMagic) != 0)
+    throw InputError(where + ": not a crevasse particle file");
+  std::uint32_t format = 0;
+  std::uint64_t header_size = 0;
+  if (!f.read(reinterpret_cast<char*>(&format), sizeof format))
+    throw InputError(where + ": truncated particle file");
+  if (format != kFormat)
+    throw InputError(where + ": particle file format " + std::to_string(format) +
+                     " (this crevasse reads format " + std::to_string(kFormat) + ")");
+  if (!f.read(reinterpret_cast<char*>(&header_size), sizeof header_size) || header_size > file_size)
+    throw InputError(where + ": truncated particle file");
+  std::string header_text(header_size, '\0');
+  if (!f.read(header_text.data(), static_cast<std::streamsize>(header_size)))
+    throw InputError(where + ": truncated particle file");
+  return header_text;
+}
+
+}  // namespace
+
+ParticleFile read_particle_file(const std::filesystem::path& path) {
+  const std::string where = path.string();
+  std::ifstream f;
+  const std::string header_text = open_and_read_header(path, where, f);
   const std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
   if (!f.eof() && f.fail()) throw InputError(where + ": cannot read the particle file");
   std::size_t at = 0;
   auto need = [&](std::size_t n) {
-    if (bytes.size() - at < n)
-      throw InputError(where + ": truncated particle file (" + std::to_string(bytes.size()) + " bytes)");
+    if (n > bytes.size() - at)
+      throw InputError(where + ": truncated particle file");
   };
   auto get = [&]<class T>(T& v) {
     need(sizeof v);
     std::memcpy(&v, bytes.data() + at, sizeof v);
     at += sizeof v;
   };
-  if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
-    throw InputError(where + ": not a crevasse particle file");
-  at = sizeof kMagic;
-  std::uint32_t format = 0;
-  get(format);
-  if (format != kFormat)
-    throw InputError(where + ": particle file format " + std::to_string(format) +
-                     " (this crevasse reads format " + std::to_string(kFormat) + ")");
-  std::uint64_t header_size = 0, raw_size = 0, packed_size = 0;
+  std::uint64_t raw_size = 0, packed_size = 0;
   std::uint32_t crc = 0;
-  get(header_size);
-  need(header_size);
-  const std::string header_text = bytes.substr(at, header_size);
-  at += header_size;
   get(raw_size);
   get(packed_size);
   get(crc);
@@ -215,26 +232,8 @@ ParticleFile read_particle_file(const std::filesystem::path& path) {
 
 nlohmann::json read_particle_file_metadata(const std::filesystem::path& path) {
   const std::string where = path.string();
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec))
-    throw InputError(where + ": no such particle file (a regular file)");
-  std::ifstream f(path, std::ios::binary);
-  char magic[sizeof kMagic];
-  std::uint32_t format = 0;
-  std::uint64_t header_size = 0;
-  if (!f.read(magic, sizeof magic) || std::memcmp(magic, kMagic, sizeof kMagic) != 0)
-    throw InputError(where + ": not a crevasse particle file");
-  if (!f.read(reinterpret_cast<char*>(&format), sizeof format) ||
-      !f.read(reinterpret_cast<char*>(&header_size), sizeof header_size))
-    throw InputError(where + ": truncated particle file");
-  if (format != kFormat)
-    throw InputError(where + ": particle file format " + std::to_string(format) +
-                     " (this crevasse reads format " + std::to_string(kFormat) + ")");
-  const auto file_size = std::filesystem::file_size(path, ec);
-  if (ec || header_size > file_size) throw InputError(where + ": truncated particle file");
-  std::string header_text(header_size, '\0');
-  if (!f.read(header_text.data(), static_cast<std::streamsize>(header_size)))
-    throw InputError(where + ": truncated particle file");
+  std::ifstream f;
+  const std::string header_text = open_and_read_header(path, where, f);
   try {
     return nlohmann::json::parse(header_text).at("metadata");
   } catch (const std::exception& e) {

@@ -24,7 +24,7 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
   // symlink_status: a dangling link or a FIFO is still "there" and must be dropped, not opened.
   if (!checkpoint.empty() && std::filesystem::exists(std::filesystem::symlink_status(checkpoint, exists_ec))) {
     try {
-      sim.load_checkpoint(checkpoint);  // changes nothing unless the whole file is good
+      out.earlier_wall_s = sim.load_checkpoint(checkpoint);  // changes nothing unless the whole file is good
       out.resumed_from_time_s = sim.time();
     } catch (const SimulationError& e) {
       std::error_code ec;
@@ -36,16 +36,16 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
                       "the case runs from t = 0");
     }
   }
+  const auto wall_now = [&] { return std::chrono::duration<double>(clock::now() - t0).count(); };
   double last_checkpoint_wall = 0.0;
   // A checkpoint that cannot be written costs only the time it would have saved.
   auto save_checkpoint = [&] {
     try {
-      sim.save_checkpoint(checkpoint);
+      sim.save_checkpoint(checkpoint, out.earlier_wall_s + wall_now());
     } catch (const SimulationError& e) {
       obs->on_warning(std::string(e.what()) + "; the case goes on without it");
     }
   };
-  const auto wall_now = [&] { return std::chrono::duration<double>(clock::now() - t0).count(); };
   auto check_time_limit = [&](double wall, double done) {
     if (scene.wall_time_limit > 0 && wall > scene.wall_time_limit) {
       char msg[240];
@@ -70,6 +70,7 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
     if (scene.max_steps > 0) f = std::max(f, static_cast<double>(sim.steps()) / scene.max_steps);
     return std::clamp(f, 0.0, 1.0);
   };
+  if (obs && out.resumed_from_time_s >= 0.0) obs->on_resumed(fraction(), out.earlier_wall_s);
 
   int output_index = 0;
   double next_output = 0.0;

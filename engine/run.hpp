@@ -42,6 +42,9 @@ class RunObserver {
   virtual std::string checkpoint_path() const { return {}; }
   virtual double checkpoint_interval_s() const { return 600.0; }
   virtual void on_warning(const std::string& /*message*/) {}
+  // Called once, before the first step, when the run continues from its checkpoint: how far it
+  // had got then (as RunProgress::fraction_done) and the wall seconds it had cost.
+  virtual void on_resumed(double /*fraction_done*/, double /*earlier_wall_s*/) {}
   // Return true to stop the run early (cancellation); the run then ends with "cancelled".
   virtual bool cancelled() { return false; }
   // Wall seconds between on_progress calls.
@@ -88,6 +91,8 @@ struct RunSummary {
   nlohmann::json stage_seconds;  // per stage: seconds and calls
   double final_ice_front_x = 0.0;  // front of the connected ice at the end [m]
   double resumed_from_time_s = -1.0;  // simulated time of the checkpoint it continued from; −1: none
+  // Wall seconds of the sittings before that checkpoint (0: none); wall_s is this sitting's.
+  double earlier_wall_s = 0.0;
   ParticleSnapshot final_snapshot;
 };
 

@@ -795,21 +795,22 @@ void Simulation<Dim>::update_time_step() {
 }
 
 template <int Dim>
-void Simulation<Dim>::save_checkpoint(const std::string& path) const {
+void Simulation<Dim>::save_checkpoint(const std::string& path, double wall_s) const {
   const RunCounters run{time_,         dt_,     steps_,    particle_steps_, return_map_evaluations_,
                         removed_mass_, front_x_, max_speed_, settled_,       inflow_mass_,
-                        inflow_columns_};
+                        inflow_columns_, wall_s};
   crevasse::save_checkpoint(path, scene_, run, particles_, gate_);
 }
 
 template <int Dim>
-void Simulation<Dim>::load_checkpoint(const std::string& path) {
+double Simulation<Dim>::load_checkpoint(const std::string& path) {
   RunCounters r;
   crevasse::load_checkpoint(path, scene_, r, particles_, gate_);
   time_ = r.time; dt_ = r.dt; steps_ = r.steps; particle_steps_ = r.particle_steps;
   return_map_evaluations_ = r.return_map_evaluations; removed_mass_ = r.removed_mass; front_x_ = r.front_x;
   max_speed_ = r.max_speed; settled_ = r.settled; settling_ = false;
   inflow_mass_ = r.inflow_mass; inflow_columns_ = r.inflow_columns;
+  return r.wall_s;
 }
 
 template class Simulation<2>;

@@ -4,12 +4,12 @@ namespace crevasse {
 
 CaseContext::CaseContext(int threads, double time_limit_s,
                          const analysis::MeasureSettings& measurement,
-                         const std::atomic<bool>& stop, std::atomic<double>& fraction)
+                         const std::atomic<bool>& stop, CaseProgress& progress)
     : threads_(threads),
       time_limit_s_(time_limit_s),
       measurement_(measurement),
       stop_(stop),
-      fraction_(fraction),
+      progress_(progress),
       start_(std::chrono::steady_clock::now()) {}
 
 double CaseContext::elapsed_s() const {

@@ -32,12 +32,20 @@ struct CaseOutcome {
   std::optional<analysis::CrevasseMeasurement> measurement;
 };
 
+// How far a running case has got, written by the case and read by the runner's writer (the ETA).
+struct CaseProgress {
+  std::atomic<double> fraction{0.0};  // 0 to 1
+  // Where the case continued from when it resumed from a checkpoint (0 to 1); −1: it started
+  // fresh, or has not said yet. Set before any fraction past it is reported.
+  std::atomic<double> resumed_from{-1.0};
+};
+
 // What the runner gives a case: its budget, a way to learn that it should stop, and a way to
 // report how far it has got (for the ETA).
 class CaseContext {
  public:
   CaseContext(int threads, double time_limit_s, const analysis::MeasureSettings& measurement,
-              const std::atomic<bool>& stop, std::atomic<double>& fraction);
+              const std::atomic<bool>& stop, CaseProgress& progress);
   int threads() const { return threads_; }
   double time_limit_s() const { return time_limit_s_; }  // 0 = none
   const analysis::MeasureSettings& measurement() const { return measurement_; }
@@ -45,8 +53,16 @@ class CaseContext {
   // CaseOutcome::out_of_time. The runner takes a cancelled case without it as stopped.
   bool time_limit_exceeded() const;
   bool stop_requested() const { return stop_.load(); }
-  void report_fraction(double f) { fraction_.store(f); }
+  void report_fraction(double f) { progress_.fraction.store(f); }
+  // The case continued from a checkpoint written at `fraction`, after `earlier_wall_s` wall
+  // seconds of earlier sittings; both count in its ETA and its stored wall time.
+  void report_resumed(double fraction, double earlier_wall_s) {
+    earlier_wall_s_ = earlier_wall_s;
+    progress_.resumed_from.store(fraction);
+  }
   double elapsed_s() const;
+  // This sitting's wall seconds and those of the sittings before its checkpoint.
+  double whole_wall_s() const { return elapsed_s() + earlier_wall_s_; }
   // Where the case keeps its checkpoint and how often it writes it (wall s); empty: none.
   void set_checkpoint(std::filesystem::path file, double interval_s) {
     checkpoint_file_ = std::move(file);
@@ -72,8 +88,9 @@ class CaseContext {
   double time_limit_s_;
   const analysis::MeasureSettings& measurement_;
   const std::atomic<bool>& stop_;
-  std::atomic<double>& fraction_;
+  CaseProgress& progress_;
   std::chrono::steady_clock::time_point start_;
+  double earlier_wall_s_ = 0.0;
   std::filesystem::path checkpoint_file_;
   double checkpoint_interval_s_ = 0.0;
   std::filesystem::path views_dir_;

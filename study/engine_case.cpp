@@ -31,6 +31,9 @@ class CaseObserver : public RunObserver {
   std::string checkpoint_path() const override { return ctx_.checkpoint_file().string(); }
   double checkpoint_interval_s() const override { return ctx_.checkpoint_interval_s(); }
   void on_warning(const std::string& message) override { ctx_.warn(message); }
+  void on_resumed(double fraction_done, double earlier_wall_s) override {
+    ctx_.report_resumed(fraction_done, earlier_wall_s);
+  }
 
  private:
   CaseContext& ctx_;
@@ -143,11 +146,15 @@ CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx) {
       {"removed_mass_kg", r.removed_mass},    {"inflow_mass_kg", r.inflow_mass},
       {"initial_particles", r.initial_particles},
       {"final_particles", r.final_particles}, {"return_map_evaluations", r.return_map_evaluations}};
-  out.run_json = {{"engine_wall_s", r.wall_s},
+  // The whole run's wall time, its earlier sittings included (the checkpoint carries them);
+  // stage_seconds are this sitting's.
+  const double engine_wall_s = r.wall_s + r.earlier_wall_s;
+  out.run_json = {{"engine_wall_s", engine_wall_s},
+                  {"sitting_wall_s", r.wall_s},
                   {"resumed_from_time_s", r.resumed_from_time_s},
                   {"stage_seconds", r.stage_seconds},
                   {"particle_steps_per_s",
-                   r.wall_s > 0 ? static_cast<double>(r.particle_steps) / r.wall_s : 0.0}};
+                   engine_wall_s > 0 ? static_cast<double>(r.particle_steps) / engine_wall_s : 0.0}};
   measure_final_state(study_case, ctx, r.final_snapshot, out);
   return out;
 }

@@ -14,21 +14,26 @@ void EtaEstimator::started(std::size_t slot, double now_s) {
   running_[slot] = r;
 }
 
-void EtaEstimator::observe(Running& r, double fraction, double now_s) {
+void EtaEstimator::observe(std::size_t slot, double fraction, double resumed_from, double now_s) {
+  const auto it = running_.find(slot);
+  if (it == running_.end()) return;
+  Running& r = it->second;
   r.fraction = std::clamp(fraction, 0.0, 1.0);
   r.seen_s = now_s;
-  if (r.base_fraction || r.fraction <= 0.0) return;
-  // A fresh case is first seen with little done (the writer looks every second): its clock
-  // starts at its start. One seen already well on came from a checkpoint: its clock starts now.
-  // A case so short that it passes 2 % before the first look is misread, at no cost worth
-  // mentioning.
-  if (r.fraction < kMinProgress) {
-    r.base_fraction = 0.0;
-    r.base_s = r.start_s;
-  } else {
+  if (r.base_fraction) return;
+  if (resumed_from >= 0.0) {
     r.base_fraction = r.fraction;
     r.base_s = now_s;
+  } else if (r.fraction > 0.0) {
+    r.base_fraction = 0.0;
+    r.base_s = r.start_s;
   }
+}
+
+std::vector<std::size_t> EtaEstimator::running_slots() const {
+  std::vector<std::size_t> out;
+  for (const auto& [slot, r] : running_) out.push_back(slot);
+  return out;
 }
 
 std::optional<double> EtaEstimator::speed(const Running& r) const {
@@ -39,17 +44,12 @@ std::optional<double> EtaEstimator::speed(const Running& r) const {
   return done / t;
 }
 
-void EtaEstimator::finished(std::size_t slot, double wall_s) {
-  const auto it = running_.find(slot);
-  double before = 0.0;
-  if (it != running_.end()) {
-    before = it->second.base_fraction.value_or(0.0);
-    running_.erase(it);
-  }
-  whole_case_s_.push_back(before < 1.0 ? wall_s / (1.0 - before) : wall_s);
+void EtaEstimator::finished(std::size_t slot, double whole_wall_s) {
+  running_.erase(slot);
+  whole_case_s_.push_back(whole_wall_s);
 }
 
-std::optional<double> EtaEstimator::estimate(std::size_t pending, double now_s) const {
+std::optional<double> EtaEstimator::eta(std::size_t pending, double now_s) const {
   double per_case = 0.0;
   if (!whole_case_s_.empty()) {
     for (double w : whole_case_s_) per_case += w;

@@ -154,8 +154,7 @@ class StudyRun {
     tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism,
                                     static_cast<std::size_t>(std::max(1, jobs * report_.threads_per_case)));
     exact_peak_rss_ = jobs == 1;
-    fraction_ = std::vector<std::atomic<double>>(todo_.size());
-    for (auto& f : fraction_) f.store(0.0);
+    progress_of_ = std::vector<CaseProgress>(todo_.size());
     // One plain thread per job: a job blocks on its case for minutes, which is no work for
     // TBB's scheduler, and thread start/join is a hand-over ThreadSanitizer can see (TBB's own
     // queues, in an uninstrumented libtbb, are not). Each case still runs in its own task arena.
@@ -264,7 +263,7 @@ class StudyRun {
     queue_.push(std::move(started));
     if (exact_peak_rss_) reset_peak_rss();
     top_up_memory_reserve();  // in case an earlier failure could not take all of it back
-    CaseContext ctx(threads, time_limit_, study_.measurement, stop(), fraction_[slot]);
+    CaseContext ctx(threads, time_limit_, study_.measurement, stop(), progress_of_[slot]);
     if (!opt_.views_dir.empty()) ctx.set_views_dir(opt_.views_dir);
     ctx.set_keep_particles(opt_.keep_particles);
     ctx.set_warn([this, slot](const std::string& m) { queue_.push(Event{Event::Kind::warning, slot, {}, {}, m}); });
@@ -319,7 +318,7 @@ class StudyRun {
     r.session_id = report_.session_id;
     r.started_at = started_at;
     r.finished_at = utc_now_iso8601();
-    r.wall_s = ctx.elapsed_s();
+    r.wall_s = ctx.whole_wall_s();
     r.threads = threads;
     r.peak_rss_bytes = peak_rss_bytes();
     if (failure.empty()) {
@@ -349,8 +348,12 @@ class StudyRun {
     const auto update_progress = [&] {
       progress_.running = eta.running();
       progress_.elapsed_s = seconds_since(t0_);
-      progress_.eta_s = eta.eta(
-          progress_.pending, [&](std::size_t slot) { return fraction_[slot].load(); }, progress_.elapsed_s);
+      for (const std::size_t slot : eta.running_slots()) {
+        // In this order: a case says where it resumed from before it reports any fraction.
+        const double fraction = progress_of_[slot].fraction.load();
+        eta.observe(slot, fraction, progress_of_[slot].resumed_from.load(), progress_.elapsed_s);
+      }
+      progress_.eta_s = eta.eta(progress_.pending, progress_.elapsed_s);
     };
     bool closed = false;
     while (!closed) {
@@ -426,7 +429,7 @@ class StudyRun {
   CaseFunction case_function_;
   std::vector<const StudyCase*> todo_;
   bool exact_peak_rss_ = false;
-  std::vector<std::atomic<double>> fraction_;
+  std::vector<CaseProgress> progress_of_;  // per case to run, written by its worker
   std::atomic<bool> own_stop_{false};
   std::atomic<std::size_t> next_{0};
   EventQueue queue_;

@@ -9,6 +9,7 @@
 #include <set>
 #include <sstream>
 
+#include "analysis/crevasse_measure.hpp"
 #include "engine/error.hpp"
 #include "study/case_hash.hpp"
 #include "study/json_checks.hpp"
@@ -269,9 +270,8 @@ analysis::MeasureSettings measure_settings_from_json(const json& j) {
   };
   if (o.contains("frame")) {
     const auto& f = o.at("frame");
-    if (!f.is_string() || (f != "auto" && f != "gate" && f != "final" && f != "passed" && f != "draped"))
-      fail("measurement.frame",
-           "value " + f.dump() + " is not \"auto\", \"gate\", \"final\", \"passed\" or \"draped\"");
+    if (!f.is_string() || !analysis::is_measure_frame(f.get<std::string>()))
+      fail("measurement.frame", "value " + f.dump() + " is not " + analysis::measure_frame_names());
     s.frame = f.get<std::string>();
   }
   num("damage_threshold", s.damage_threshold, {0.0, 1.0, true, true});

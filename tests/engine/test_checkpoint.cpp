@@ -122,8 +122,49 @@ std::string refusal(const SceneConfig& scene, const fs::path& file) {
   return "";
 }
 
+// A checkpoint keeps the wall time the run had cost, for the next sitting to add to. A format 2
+// file (written before it did) is still read, with no earlier wall time: a study paused then
+// continues from it.
+TEST(Checkpoint, KeepsTheWallTimeAndReadsFormat2) {
+  const SceneConfig scene = scene_from_json(test::shipped_scene_json());
+  const fs::path file = scratch("wall");
+  Simulation<2> a(scene);
+  a.step();
+  a.save_checkpoint(file.string(), 1234.5);
+  Simulation<2> b(scene);
+  EXPECT_EQ(b.load_checkpoint(file.string()), 1234.5);
+  EXPECT_EQ(b.steps(), 1);
+
+  // Format 2: the same payload without the wall time, its checksum and both markers.
+  const std::string three = slurp(file);
+  std::size_t at = 8;
+  for (int k = 0; k < 2; ++k) {  // engine version, scene
+    std::uint64_t n = 0;
+    std::memcpy(&n, three.data() + at, sizeof n);
+    at += sizeof n + n;
+  }
+  // dim; time, dt; three step counts; removed mass, front, top speed; settled; gate volume,
+  // inflow mass and columns. Then the wall time.
+  at += 4 + 2 * 8 + 3 * 8 + 3 * 8 + 1 + 3 * 8;
+  double wall = 0.0;
+  std::memcpy(&wall, three.data() + at, sizeof wall);
+  ASSERT_EQ(wall, 1234.5) << "the wall time is not where format 3 puts it";
+  std::string two = three.substr(0, at) + three.substr(at + 8);
+  two[7] = '2';
+  two[two.size() - 1] = '2';
+  const std::size_t payload = two.size() - 8 - 8 - 8;
+  const std::uint64_t sum = checkpoint::checksum(two.data() + 8, payload);
+  std::memcpy(two.data() + 8 + payload, &sum, sizeof sum);
+  spit(file, two);
+  Simulation<2> c(scene);
+  EXPECT_EQ(c.load_checkpoint(file.string()), 0.0);
+  EXPECT_EQ(c.steps(), 1);
+  expect_same_state(a.snapshot(), c.snapshot());
+  fs::remove(file);
+}
+
 // Every way a checkpoint can be unusable is refused with its reason: one flipped byte of the
-// state (the checksum), another engine version (with a valid checksum), the previous format,
+// state (the checksum), another engine version (with a valid checksum), an older format,
 // an empty file, a directory and a FIFO (refused without being opened, so it cannot block).
 TEST(Checkpoint, CorruptForeignAndNonRegularFilesAreRefused) {
   const SceneConfig scene = scene_from_json(test::shipped_scene_json());
@@ -179,6 +220,11 @@ class CheckpointingObserver : public RunObserver {
   bool cancel_now = false;
   void on_warning(const std::string& m) override { warnings.push_back(m); }
   std::vector<std::string> warnings;
+  void on_resumed(double fraction, double earlier_wall_s) override {
+    resumed_fraction = fraction;
+    resumed_wall_s = earlier_wall_s;
+  }
+  double resumed_fraction = -1.0, resumed_wall_s = -1.0;
 
  private:
   fs::path file_;
@@ -196,7 +242,7 @@ TEST(Checkpoint, UnusableOrUnwritableCheckpointsCostNothing) {
   const RunSummary whole = run_scene(scene);
 
   const fs::path file = scratch("dropped");
-  for (const std::string bytes : {std::string(), std::string("CRVCKPT2 but nothing else"), std::string(5000, 'x')}) {
+  for (const std::string bytes : {std::string(), std::string("CRVCKPT3 but nothing else"), std::string(5000, 'x')}) {
     spit(file, bytes);
     CheckpointingObserver obs(file, 0);
     const RunSummary r = run_scene(scene, &obs);
@@ -299,6 +345,12 @@ TEST(Checkpoint, CancelledRunResumesToTheUninterruptedResult) {
   const RunSummary second = run_scene(scene, &resume);
   EXPECT_EQ(second.stop_reason, "gate_length");
   EXPECT_EQ(second.resumed_from_time_s, first.sim_time_s);
+  // It says where it resumed, and the wall time of the first sitting, up to its checkpoint.
+  EXPECT_GT(resume.resumed_fraction, 0.0);
+  EXPECT_LT(resume.resumed_fraction, 1.0);
+  EXPECT_GT(second.earlier_wall_s, 0.0);
+  EXPECT_LE(second.earlier_wall_s, first.wall_s);
+  EXPECT_EQ(resume.resumed_wall_s, second.earlier_wall_s);
   EXPECT_EQ(second.steps, whole.steps);
   expect_same_state(whole.final_snapshot, second.final_snapshot);
   EXPECT_FALSE(fs::exists(file)) << "the checkpoint of a finished run is deleted";

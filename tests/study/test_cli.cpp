@@ -248,6 +248,11 @@ TEST(Cli, KilledCaseResumesFromItsCheckpoint) {
       dir / "k.db", "SELECT json_extract(run_json, '$.resumed_from_time_s') FROM cases");
   ASSERT_EQ(resumed_from.size(), 1u);
   EXPECT_GT(std::stod(resumed_from[0]), 0.0) << "the case started again from t = 0";
+  // Its wall time counts the killed sitting too, up to its checkpoint (which carried it).
+  const auto walls = test::dump_rows(dir / "k.db", "SELECT wall_s > json_extract(run_json, '$.sitting_wall_s'), "
+                                                   "json_extract(run_json, '$.engine_wall_s') > "
+                                                   "json_extract(run_json, '$.sitting_wall_s') FROM cases");
+  EXPECT_EQ(walls, std::vector<std::string>{"1|1"});
   EXPECT_TRUE(std::filesystem::is_empty(dir / "k.db.checkpoints"));
   EXPECT_EQ(test::result_dump(dir / "k.db"), test::result_dump(dir / "ref.db"));
 }
@@ -526,10 +531,25 @@ TEST(Cli, RemeasureFromKeptParticlesStoresWhatAFullRunStores) {
   EXPECT_EQ(test::dump_rows(dir / "again.db", "SELECT count(*) FROM cases WHERE json_extract(run_json, "
                                                "'$.measured_from.database') = 'kept.db'")[0], "2");
   EXPECT_TRUE(std::filesystem::exists(dir / "w" / "case_001_side_view.png"));
+  // status marks both and shows the wall time of the runs that made the particles, not the
+  // re-measurement's (the tiny runs take under a minute: status writes "%.1fs").
   const Result status = run_cli(dir.path(), "status again.db");
+  const auto run_walls = test::dump_rows(dir / "kept.db", "SELECT case_index, printf('%.1fs', "
+                                                          "json_extract(run_json, '$.engine_wall_s')) FROM cases");
+  const auto again_walls = test::dump_rows(dir / "again.db", "SELECT case_index, printf('%.1fs', wall_s) FROM cases");
+  EXPECT_NE(run_walls, again_walls) << "the run and the re-measurement took as long: the test shows nothing";
   std::size_t marked = 0;
-  for (std::size_t at = 0; (at = status.out.find("measured again from kept particles", at)) != std::string::npos; ++at)
+  std::istringstream lines(status.out);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.find("measured again from kept particles") == std::string::npos) continue;
     ++marked;
+    std::string index;
+    std::istringstream(line) >> index;
+    std::string run_wall = "?";
+    for (const std::string& row : run_walls)
+      if (row.substr(0, row.find('|')) == index) run_wall = row.substr(row.find('|') + 1);
+    EXPECT_NE(line.find(" " + run_wall + " "), std::string::npos) << "wall " << run_wall << " not in: " << line;
+  }
   EXPECT_EQ(marked, 2u) << status.out;
 
   // Another scene: nothing kept for it, so its cases fail and say why.

@@ -216,6 +216,8 @@ const BadStudy kBadStudies[] = {
        j["sweep"] = {{"cohesion_ratio", {{"log", {-0.1, 1.0, 4}}}}};
      },
      {"sweep.cohesion_ratio.log", "-0.1", "(0, inf)"}},
+    {"unknown measurement frame", [](json& j) { j["measurement"] = {{"frame", "sideways"}}; },
+     {"measurement.frame", "\"sideways\"", "'passed' or 'draped'"}},
     {"count_gaps not a boolean", [](json& j) { j["measurement"] = {{"count_gaps", "yes"}}; },
      {"measurement.count_gaps", "\"yes\"", "true or false"}},
     {"log range with zero",
