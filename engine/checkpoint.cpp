@@ -1,6 +1,8 @@
 #include "engine/checkpoint.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -47,7 +49,7 @@ void save_checkpoint(const std::string& path, const SceneConfig& scene, const Ru
   ck::put(o, run.return_map_evaluations); ck::put(o, run.removed_mass); ck::put(o, run.front_x);
   ck::put(o, run.max_speed); ck::put(o, static_cast<std::uint8_t>(run.settled));
   ck::put(o, gate.passed_volume()); ck::put(o, run.inflow_mass); ck::put(o, run.inflow_columns);
-  ck::put(o, run.wall_s);
+  ck::put(o, run.wall_s.value_or(std::numeric_limits<double>::quiet_NaN()));
   ck::put_vector(o, P.x); ck::put_vector(o, P.v); ck::put_vector(o, P.C); ck::put_vector(o, P.F_e);
   ck::put_vector(o, P.tau); ck::put_vector(o, P.mass); ck::put_vector(o, P.vol0);
   ck::put_vector(o, P.eps_v_p); ck::put_vector(o, P.drive_x0); ck::put_vector(o, P.x_ref);
@@ -125,7 +127,12 @@ void load_checkpoint(const std::string& path, const SceneConfig& scene, RunCount
   ck::get(i, r.return_map_evaluations); ck::get(i, r.removed_mass); ck::get(i, r.front_x);
   ck::get(i, r.max_speed); ck::get(i, settled); ck::get(i, gate_volume);
   ck::get(i, r.inflow_mass); ck::get(i, r.inflow_columns);
-  if (format != ck::kFormat2) ck::get(i, r.wall_s);
+  r.wall_s.reset();
+  if (format != ck::kFormat2) {
+    double wall = 0.0;
+    ck::get(i, wall);
+    if (!std::isnan(wall)) r.wall_s = wall;
+  }
   r.settled = settled != 0;
   Particles<Dim> P;
   const std::uint64_t kMax = payload_size;

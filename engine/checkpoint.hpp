@@ -6,6 +6,7 @@
 // with a checksum over everything between the magic strings; a checkpoint of another scene or
 // engine version, or one whose checksum does not match, is refused.
 #include <cstdint>
+#include <optional>
 #include <istream>
 #include <ostream>
 #include <string>
@@ -26,8 +27,9 @@ struct RunCounters {
   double inflow_mass = 0.0;
   std::int64_t inflow_columns = 0;
   // Wall seconds the run had taken when the checkpoint was written, over all its sittings, so
-  // that a resumed run reports its whole cost. Format 2 files did not keep it: read as 0.
-  double wall_s = 0.0;
+  // that a resumed run reports its whole cost. Unknown (nullopt) for a format 2 file, and for
+  // every later checkpoint of a run resumed from one; written as NaN.
+  std::optional<double> wall_s = 0.0;
 };
 
 // Written atomically (temporary file, then rename); SimulationError when it cannot be, and then

@@ -20,11 +20,12 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
   out.initial_mass = sim.total_mass();
   out.initial_particles = sim.particles().size();
   const std::string checkpoint = obs ? obs->checkpoint_path() : std::string();
+  std::optional<double> earlier_wall_s = 0.0;  // of the sittings before the checkpoint resumed
   std::error_code exists_ec;
   // symlink_status: a dangling link or a FIFO is still "there" and must be dropped, not opened.
   if (!checkpoint.empty() && std::filesystem::exists(std::filesystem::symlink_status(checkpoint, exists_ec))) {
     try {
-      out.earlier_wall_s = sim.load_checkpoint(checkpoint);  // changes nothing unless the whole file is good
+      earlier_wall_s = sim.load_checkpoint(checkpoint);  // changes nothing unless the whole file is good
       out.resumed_from_time_s = sim.time();
     } catch (const SimulationError& e) {
       std::error_code ec;
@@ -41,7 +42,8 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
   // A checkpoint that cannot be written costs only the time it would have saved.
   auto save_checkpoint = [&] {
     try {
-      sim.save_checkpoint(checkpoint, out.earlier_wall_s + wall_now());
+      sim.save_checkpoint(checkpoint, earlier_wall_s ? std::optional<double>(*earlier_wall_s + wall_now())
+                                                     : std::nullopt);
     } catch (const SimulationError& e) {
       obs->on_warning(std::string(e.what()) + "; the case goes on without it");
     }
@@ -70,7 +72,7 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
     if (scene.max_steps > 0) f = std::max(f, static_cast<double>(sim.steps()) / scene.max_steps);
     return std::clamp(f, 0.0, 1.0);
   };
-  if (obs && out.resumed_from_time_s >= 0.0) obs->on_resumed(fraction(), out.earlier_wall_s);
+  if (obs && out.resumed_from_time_s >= 0.0) obs->on_resumed(fraction(), earlier_wall_s);
 
   int output_index = 0;
   double next_output = 0.0;

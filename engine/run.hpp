@@ -3,6 +3,7 @@
 // through an observer the caller passes in: the engine has no global logger.
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
 #include "engine/scene.hpp"
@@ -43,8 +44,10 @@ class RunObserver {
   virtual double checkpoint_interval_s() const { return 600.0; }
   virtual void on_warning(const std::string& /*message*/) {}
   // Called once, before the first step, when the run continues from its checkpoint: how far it
-  // had got then (as RunProgress::fraction_done) and the wall seconds it had cost.
-  virtual void on_resumed(double /*fraction_done*/, double /*earlier_wall_s*/) {}
+  // had got then (as RunProgress::fraction_done) and the wall seconds it had cost (nullopt: not
+  // known, the checkpoint being of format 2). This is the one way the earlier wall time leaves
+  // the run: it reaches the observer also when the run then fails or runs out of time.
+  virtual void on_resumed(double /*fraction_done*/, std::optional<double> /*earlier_wall_s*/) {}
   // Return true to stop the run early (cancellation); the run then ends with "cancelled".
   virtual bool cancelled() { return false; }
   // Wall seconds between on_progress calls.
@@ -81,7 +84,7 @@ struct RunSummary {
   std::int64_t particle_steps = 0;
   std::int64_t return_map_evaluations = 0;
   double sim_time_s = 0.0;
-  double wall_s = 0.0;
+  double wall_s = 0.0;  // this sitting's (RunObserver::on_resumed gives the earlier ones')
   double initial_mass = 0.0;
   double final_mass = 0.0;
   double removed_mass = 0.0;
@@ -91,8 +94,6 @@ struct RunSummary {
   nlohmann::json stage_seconds;  // per stage: seconds and calls
   double final_ice_front_x = 0.0;  // front of the connected ice at the end [m]
   double resumed_from_time_s = -1.0;  // simulated time of the checkpoint it continued from; −1: none
-  // Wall seconds of the sittings before that checkpoint (0: none); wall_s is this sitting's.
-  double earlier_wall_s = 0.0;
   ParticleSnapshot final_snapshot;
 };
 

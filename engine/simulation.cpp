@@ -795,7 +795,7 @@ void Simulation<Dim>::update_time_step() {
 }
 
 template <int Dim>
-void Simulation<Dim>::save_checkpoint(const std::string& path, double wall_s) const {
+void Simulation<Dim>::save_checkpoint(const std::string& path, std::optional<double> wall_s) const {
   const RunCounters run{time_,         dt_,     steps_,    particle_steps_, return_map_evaluations_,
                         removed_mass_, front_x_, max_speed_, settled_,       inflow_mass_,
                         inflow_columns_, wall_s};
@@ -803,7 +803,7 @@ void Simulation<Dim>::save_checkpoint(const std::string& path, double wall_s) co
 }
 
 template <int Dim>
-double Simulation<Dim>::load_checkpoint(const std::string& path) {
+std::optional<double> Simulation<Dim>::load_checkpoint(const std::string& path) {
   RunCounters r;
   crevasse::load_checkpoint(path, scene_, r, particles_, gate_);
   time_ = r.time; dt_ = r.dt; steps_ = r.steps; particle_steps_ = r.particle_steps;

@@ -94,9 +94,10 @@ class Simulation {
   // Checkpoints (engine/checkpoint.hpp): the whole state the next step reads, written atomically
   // (temporary file, then rename). load_checkpoint throws SimulationError when the file is not a
   // checkpoint of this scene and engine version, or is truncated.
-  // `wall_s`: what the run has cost so far, kept in the file; load_checkpoint returns it.
-  void save_checkpoint(const std::string& path, double wall_s = 0.0) const;
-  double load_checkpoint(const std::string& path);
+  // `wall_s`: what the run has cost so far (nullopt: unknown), kept in the file;
+  // load_checkpoint returns it.
+  void save_checkpoint(const std::string& path, std::optional<double> wall_s = 0.0) const;
+  std::optional<double> load_checkpoint(const std::string& path);
 
   // Measurement gate at scene.gate_x() (when scene.records_gate()): the ice length along flow
   // that has reached it, Σ V0 of the particles recorded / the slab's cross-section [m].

@@ -55,14 +55,17 @@ class CaseContext {
   bool stop_requested() const { return stop_.load(); }
   void report_fraction(double f) { progress_.fraction.store(f); }
   // The case continued from a checkpoint written at `fraction`, after `earlier_wall_s` wall
-  // seconds of earlier sittings; both count in its ETA and its stored wall time.
-  void report_resumed(double fraction, double earlier_wall_s) {
+  // seconds of earlier sittings (nullopt: not known); both count in its ETA and its stored
+  // wall time.
+  void report_resumed(double fraction, std::optional<double> earlier_wall_s) {
     earlier_wall_s_ = earlier_wall_s;
     progress_.resumed_from.store(fraction);
   }
   double elapsed_s() const;
-  // This sitting's wall seconds and those of the sittings before its checkpoint.
-  double whole_wall_s() const { return elapsed_s() + earlier_wall_s_; }
+  std::optional<double> earlier_wall_s() const { return earlier_wall_s_; }
+  // This sitting's wall seconds and those of the sittings before its checkpoint, when known
+  // (otherwise a lower bound: run_json says so).
+  double whole_wall_s() const { return elapsed_s() + earlier_wall_s_.value_or(0.0); }
   // Where the case keeps its checkpoint and how often it writes it (wall s); empty: none.
   void set_checkpoint(std::filesystem::path file, double interval_s) {
     checkpoint_file_ = std::move(file);
@@ -90,7 +93,7 @@ class CaseContext {
   const std::atomic<bool>& stop_;
   CaseProgress& progress_;
   std::chrono::steady_clock::time_point start_;
-  double earlier_wall_s_ = 0.0;
+  std::optional<double> earlier_wall_s_ = 0.0;
   std::filesystem::path checkpoint_file_;
   double checkpoint_interval_s_ = 0.0;
   std::filesystem::path views_dir_;

@@ -31,7 +31,7 @@ class CaseObserver : public RunObserver {
   std::string checkpoint_path() const override { return ctx_.checkpoint_file().string(); }
   double checkpoint_interval_s() const override { return ctx_.checkpoint_interval_s(); }
   void on_warning(const std::string& message) override { ctx_.warn(message); }
-  void on_resumed(double fraction_done, double earlier_wall_s) override {
+  void on_resumed(double fraction_done, std::optional<double> earlier_wall_s) override {
     ctx_.report_resumed(fraction_done, earlier_wall_s);
   }
 
@@ -147,14 +147,20 @@ CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx) {
       {"initial_particles", r.initial_particles},
       {"final_particles", r.final_particles}, {"return_map_evaluations", r.return_map_evaluations}};
   // The whole run's wall time, its earlier sittings included (the checkpoint carries them);
-  // stage_seconds are this sitting's.
-  const double engine_wall_s = r.wall_s + r.earlier_wall_s;
+  // stage_seconds are this sitting's. A format 2 checkpoint did not keep them: then the wall
+  // times stored are this sitting's alone, and run_json says so.
+  const std::optional<double> earlier = ctx.earlier_wall_s();
+  const double engine_wall_s = r.wall_s + earlier.value_or(0.0);
   out.run_json = {{"engine_wall_s", engine_wall_s},
                   {"sitting_wall_s", r.wall_s},
                   {"resumed_from_time_s", r.resumed_from_time_s},
                   {"stage_seconds", r.stage_seconds},
                   {"particle_steps_per_s",
                    engine_wall_s > 0 ? static_cast<double>(r.particle_steps) / engine_wall_s : 0.0}};
+  if (!earlier) {
+    out.run_json["earlier_wall_unknown"] = true;
+    out.run_json["particle_steps_per_s"] = nullptr;  // all the steps over one sitting's wall
+  }
   measure_final_state(study_case, ctx, r.final_snapshot, out);
   return out;
 }

@@ -16,8 +16,10 @@ void EtaEstimator::started(std::size_t slot, double now_s) {
 
 void EtaEstimator::observe(std::size_t slot, double fraction, double resumed_from, double now_s) {
   const auto it = running_.find(slot);
-  if (it == running_.end()) return;
-  Running& r = it->second;
+  if (it != running_.end()) observe(it->second, fraction, resumed_from, now_s);
+}
+
+void EtaEstimator::observe(Running& r, double fraction, double resumed_from, double now_s) {
   r.fraction = std::clamp(fraction, 0.0, 1.0);
   r.seen_s = now_s;
   if (r.base_fraction) return;
@@ -28,12 +30,6 @@ void EtaEstimator::observe(std::size_t slot, double fraction, double resumed_fro
     r.base_fraction = 0.0;
     r.base_s = r.start_s;
   }
-}
-
-std::vector<std::size_t> EtaEstimator::running_slots() const {
-  std::vector<std::size_t> out;
-  for (const auto& [slot, r] : running_) out.push_back(slot);
-  return out;
 }
 
 std::optional<double> EtaEstimator::speed(const Running& r) const {

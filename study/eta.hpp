@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <map>
 #include <optional>
+#include <utility>
 #include <vector>
 
 namespace crevasse {
@@ -18,10 +19,17 @@ class EtaEstimator {
   // where (negative: it started fresh). A resumed case's speed counts from where it was first
   // seen after resuming, a fresh one's from its start.
   void observe(std::size_t slot, double fraction, double resumed_from, double now_s);
+  // observe() for every running case: read(slot) gives its {fraction, resumed_from}.
+  template <class Read>
+  void observe_running(Read read, double now_s) {
+    for (auto& [slot, r] : running_) {
+      const auto [fraction, resumed_from] = read(slot);
+      observe(r, fraction, resumed_from, now_s);
+    }
+  }
   // A finished case's whole wall time, over all its sittings, stands for each pending case.
   void finished(std::size_t slot, double whole_wall_s);
   std::size_t running() const { return running_.size(); }
-  std::vector<std::size_t> running_slots() const;
   // Seconds until the pending and running cases are done; none before anything can be projected.
   std::optional<double> eta(std::size_t pending, double now_s) const;
 
@@ -32,6 +40,7 @@ class EtaEstimator {
     double fraction = 0.0, seen_s = 0.0;
   };
   std::optional<double> speed(const Running& r) const;  // fraction per second
+  static void observe(Running& r, double fraction, double resumed_from, double now_s);
 
   int jobs_;
   std::map<std::size_t, Running> running_;

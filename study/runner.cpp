@@ -348,11 +348,13 @@ class StudyRun {
     const auto update_progress = [&] {
       progress_.running = eta.running();
       progress_.elapsed_s = seconds_since(t0_);
-      for (const std::size_t slot : eta.running_slots()) {
-        // In this order: a case says where it resumed from before it reports any fraction.
-        const double fraction = progress_of_[slot].fraction.load();
-        eta.observe(slot, fraction, progress_of_[slot].resumed_from.load(), progress_.elapsed_s);
-      }
+      eta.observe_running(
+          [&](std::size_t slot) {
+            // In this order: a case says where it resumed from before it reports any fraction.
+            const double fraction = progress_of_[slot].fraction.load();
+            return std::pair{fraction, progress_of_[slot].resumed_from.load()};
+          },
+          progress_.elapsed_s);
       progress_.eta_s = eta.eta(progress_.pending, progress_.elapsed_s);
     };
     bool closed = false;

@@ -255,17 +255,23 @@ TEST(MeasureFloor, SourceRuleKeepsBothAndDropsOnlyTheSpacing) {
   EXPECT_THROW(measure_crevasses(make_slab(spec, notches), bad), std::invalid_argument);
 }
 
+// A notched slab as after a run over a step whose top is at x = 100 m, the ice that started
+// upstream of it having got to x = 900 m; the ice past that lay past the step from the start.
+ParticleSnapshot slab_past_a_step(const SlabSpec& spec, const std::vector<Notch>& notches) {
+  ParticleSnapshot s = make_slab(spec, notches);
+  s.step_top_x_m = 100.0;
+  s.upstream_ice_front_x_m = 900.0;
+  return s;
+}
+
 // The "passed" frame measures the ice that came over the step during the run: from half an H_i
 // past the top of the step to half an H_i behind the front of the ice that started upstream of
 // it. A notch in the ice that lay past the step from the start is left out.
 TEST(MeasureWindow, PassedFrameEndsAtTheIceThatCameOverTheStep) {
   SlabSpec spec;
-  const std::vector<Notch> notches = {{.x_m = 300.0, .depth_m = 30.0},
-                                      {.x_m = 600.0, .depth_m = 30.0},
-                                      {.x_m = 1200.0, .depth_m = 30.0}};
-  ParticleSnapshot s = make_slab(spec, notches);
-  s.step_top_x_m = 100.0;
-  s.upstream_ice_front_x_m = 900.0;
+  ParticleSnapshot s = slab_past_a_step(spec, {{.x_m = 300.0, .depth_m = 30.0},
+                                               {.x_m = 600.0, .depth_m = 30.0},
+                                               {.x_m = 1200.0, .depth_m = 30.0}});
   MeasureSettings passed;
   passed.frame = "passed";
   const CrevasseMeasurement m = measure_crevasses(s, passed);
@@ -282,13 +288,10 @@ TEST(MeasureWindow, PassedFrameEndsAtTheIceThatCameOverTheStep) {
 // from the front of the ice that started upstream of the step to half an H_i behind the front.
 TEST(MeasureWindow, DrapedFrameHoldsTheIceThatLayPastTheStepFromTheStart) {
   SlabSpec spec;
-  const std::vector<Notch> notches = {{.x_m = 600.0, .depth_m = 30.0},
-                                      {.x_m = 1000.0, .depth_m = 30.0},
-                                      {.x_m = 1300.0, .depth_m = 30.0},
-                                      {.x_m = 1975.0, .depth_m = 30.0}};
-  ParticleSnapshot s = make_slab(spec, notches);
-  s.step_top_x_m = 100.0;
-  s.upstream_ice_front_x_m = 900.0;
+  ParticleSnapshot s = slab_past_a_step(spec, {{.x_m = 600.0, .depth_m = 30.0},
+                                               {.x_m = 1000.0, .depth_m = 30.0},
+                                               {.x_m = 1300.0, .depth_m = 30.0},
+                                               {.x_m = 1975.0, .depth_m = 30.0}});
   MeasureSettings draped;
   draped.frame = "draped";
   const CrevasseMeasurement m = measure_crevasses(s, draped);

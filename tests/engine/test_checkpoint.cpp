@@ -125,18 +125,9 @@ std::string refusal(const SceneConfig& scene, const fs::path& file) {
 // A checkpoint keeps the wall time the run had cost, for the next sitting to add to. A format 2
 // file (written before it did) is still read, with no earlier wall time: a study paused then
 // continues from it.
-TEST(Checkpoint, KeepsTheWallTimeAndReadsFormat2) {
-  const SceneConfig scene = scene_from_json(test::shipped_scene_json());
-  const fs::path file = scratch("wall");
-  Simulation<2> a(scene);
-  a.step();
-  a.save_checkpoint(file.string(), 1234.5);
-  Simulation<2> b(scene);
-  EXPECT_EQ(b.load_checkpoint(file.string()), 1234.5);
-  EXPECT_EQ(b.steps(), 1);
-
-  // Format 2: the same payload without the wall time, its checksum and both markers.
-  const std::string three = slurp(file);
+// The format 2 file of a format 3 one: the same payload without the wall time, its checksum
+// and both markers. `wall` receives the wall time the format 3 file held.
+std::string to_format2(const std::string& three, double& wall) {
   std::size_t at = 8;
   for (int k = 0; k < 2; ++k) {  // engine version, scene
     std::uint64_t n = 0;
@@ -146,20 +137,39 @@ TEST(Checkpoint, KeepsTheWallTimeAndReadsFormat2) {
   // dim; time, dt; three step counts; removed mass, front, top speed; settled; gate volume,
   // inflow mass and columns. Then the wall time.
   at += 4 + 2 * 8 + 3 * 8 + 3 * 8 + 1 + 3 * 8;
-  double wall = 0.0;
   std::memcpy(&wall, three.data() + at, sizeof wall);
-  ASSERT_EQ(wall, 1234.5) << "the wall time is not where format 3 puts it";
   std::string two = three.substr(0, at) + three.substr(at + 8);
   two[7] = '2';
   two[two.size() - 1] = '2';
   const std::size_t payload = two.size() - 8 - 8 - 8;
   const std::uint64_t sum = checkpoint::checksum(two.data() + 8, payload);
   std::memcpy(two.data() + 8 + payload, &sum, sizeof sum);
-  spit(file, two);
+  return two;
+}
+
+// The wall time spent is kept; a format 2 file, which did not keep it, is read with the wall
+// time unknown, and an unknown wall time stays unknown when written again.
+TEST(Checkpoint, KeepsTheWallTimeAndReadsFormat2) {
+  const SceneConfig scene = scene_from_json(test::shipped_scene_json());
+  const fs::path file = scratch("wall");
+  Simulation<2> a(scene);
+  a.step();
+  a.save_checkpoint(file.string(), 1234.5);
+  Simulation<2> b(scene);
+  EXPECT_EQ(b.load_checkpoint(file.string()), std::optional<double>(1234.5));
+  EXPECT_EQ(b.steps(), 1);
+
+  double wall = 0.0;
+  spit(file, to_format2(slurp(file), wall));
+  ASSERT_EQ(wall, 1234.5) << "the wall time is not where format 3 puts it";
   Simulation<2> c(scene);
-  EXPECT_EQ(c.load_checkpoint(file.string()), 0.0);
+  EXPECT_EQ(c.load_checkpoint(file.string()), std::nullopt);
   EXPECT_EQ(c.steps(), 1);
   expect_same_state(a.snapshot(), c.snapshot());
+
+  c.save_checkpoint(file.string(), std::nullopt);
+  Simulation<2> d(scene);
+  EXPECT_EQ(d.load_checkpoint(file.string()), std::nullopt);
   fs::remove(file);
 }
 
@@ -220,11 +230,12 @@ class CheckpointingObserver : public RunObserver {
   bool cancel_now = false;
   void on_warning(const std::string& m) override { warnings.push_back(m); }
   std::vector<std::string> warnings;
-  void on_resumed(double fraction, double earlier_wall_s) override {
+  void on_resumed(double fraction, std::optional<double> earlier_wall_s) override {
     resumed_fraction = fraction;
     resumed_wall_s = earlier_wall_s;
   }
-  double resumed_fraction = -1.0, resumed_wall_s = -1.0;
+  double resumed_fraction = -1.0;
+  std::optional<double> resumed_wall_s = -1.0;
 
  private:
   fs::path file_;
@@ -348,12 +359,35 @@ TEST(Checkpoint, CancelledRunResumesToTheUninterruptedResult) {
   // It says where it resumed, and the wall time of the first sitting, up to its checkpoint.
   EXPECT_GT(resume.resumed_fraction, 0.0);
   EXPECT_LT(resume.resumed_fraction, 1.0);
-  EXPECT_GT(second.earlier_wall_s, 0.0);
-  EXPECT_LE(second.earlier_wall_s, first.wall_s);
-  EXPECT_EQ(resume.resumed_wall_s, second.earlier_wall_s);
+  ASSERT_TRUE(resume.resumed_wall_s.has_value());
+  EXPECT_GT(*resume.resumed_wall_s, 0.0);
+  EXPECT_LE(*resume.resumed_wall_s, first.wall_s);
   EXPECT_EQ(second.steps, whole.steps);
   expect_same_state(whole.final_snapshot, second.final_snapshot);
   EXPECT_FALSE(fs::exists(file)) << "the checkpoint of a finished run is deleted";
+}
+
+// A run resumed from a format 2 checkpoint says that the earlier wall time is not known, and
+// the checkpoints it writes keep it unknown (not 0, which would understate the case's cost).
+TEST(Checkpoint, AFormat2ResumeReportsTheEarlierWallTimeAsUnknown) {
+  nlohmann::json j = test::shipped_scene_json();
+  j["run"]["gate_length"] = 100.0;
+  const SceneConfig scene = scene_from_json(j);
+  const fs::path file = scratch("format2");
+  CheckpointingObserver killer(file, 2);
+  ASSERT_EQ(run_scene(scene, &killer).stop_reason, "cancelled");
+  double wall = 0.0;
+  spit(file, to_format2(slurp(file), wall));
+
+  CheckpointingObserver again(file, 2);
+  ASSERT_EQ(run_scene(scene, &again).stop_reason, "cancelled");
+  EXPECT_GT(again.resumed_fraction, 0.0);
+  EXPECT_EQ(again.resumed_wall_s, std::nullopt);
+  ASSERT_TRUE(fs::exists(file));
+  EXPECT_EQ(slurp(file)[7], '3') << "the checkpoint is rewritten in the current format";
+  CheckpointingObserver last(file, 0);
+  EXPECT_EQ(run_scene(scene, &last).stop_reason, "gate_length");
+  EXPECT_EQ(last.resumed_wall_s, std::nullopt);
 }
 
 // A run stopped by run.wall_time_limit saves its checkpoint as it stops (none is due by the

@@ -39,9 +39,7 @@ TEST(Eta, CasesAreSharedOverTheJobs) {
   EtaEstimator e(2);
   e.started(0, 0.0);
   e.started(1, 0.0);
-  EXPECT_EQ(e.running_slots(), (std::vector<std::size_t>{0, 1}));
-  e.observe(0, 0.5, kFresh, 50.0);
-  e.observe(1, 0.25, kFresh, 50.0);
+  e.observe_running([](std::size_t slot) { return std::pair{slot == 0 ? 0.5 : 0.25, kFresh}; }, 50.0);
   // 50 s and 150 s still to run, two pending of (100 + 200)/2 s each: 500 s over two jobs.
   EXPECT_NEAR(*e.eta(2, 50.0), 250.0, 1e-9);
   e.stopped(1);

@@ -89,12 +89,12 @@ TEST(Runner, FailFastStopsAtTheFirstFailureAndLeavesTheRestPending) {
       "done,failed,pending,pending,pending");
 }
 
-TEST(Runner, FailFastCancelsRunningCasesWhichStayPending) {
-  test::ScratchDir dir("runner");
-  const Study study = test::parse(test::tiny_study(4));
-  auto fn = [](const StudyCase& c, CaseContext& ctx) {
+// A case function for fail-fast: case 0 fails after `delay`; every other case runs until it is
+// asked to stop, and stops as cancelled.
+CaseFunction first_case_fails_after(std::chrono::milliseconds delay) {
+  return [delay](const StudyCase& c, CaseContext& ctx) {
     if (c.index == 0) {
-      std::this_thread::sleep_for(50ms);
+      std::this_thread::sleep_for(delay);
       throw SimulationError("boom");
     }
     while (!ctx.stop_requested()) std::this_thread::sleep_for(5ms);  // a long case
@@ -102,7 +102,12 @@ TEST(Runner, FailFastCancelsRunningCasesWhichStayPending) {
     o.cancelled = true;
     return o;
   };
-  RunnerOptions o = fake_options(dir / "s.db", fn, 2);
+}
+
+TEST(Runner, FailFastCancelsRunningCasesWhichStayPending) {
+  test::ScratchDir dir("runner");
+  const Study study = test::parse(test::tiny_study(4));
+  RunnerOptions o = fake_options(dir / "s.db", first_case_fails_after(50ms), 2);
   o.fail_fast = true;
   const RunnerReport r = run_study(study, o);
   EXPECT_TRUE(r.stopped);
@@ -139,17 +144,8 @@ TEST(Runner, ACaseOverItsTimeLimitFails) {
 TEST(Runner, AStopAfterTheTimeLimitPassedLeavesTheCasePending) {
   test::ScratchDir dir("runner");
   const Study study = test::parse(test::tiny_study(2));
-  auto fn = [](const StudyCase& c, CaseContext& ctx) {
-    if (c.index == 0) {
-      std::this_thread::sleep_for(300ms);
-      throw SimulationError("boom");  // fail-fast stops the other case, past its limit
-    }
-    while (!ctx.stop_requested()) std::this_thread::sleep_for(5ms);
-    CaseOutcome o;
-    o.cancelled = true;
-    return o;
-  };
-  RunnerOptions o = fake_options(dir / "s.db", fn, 2);
+  // Case 0's failure stops case 1 after its limit has passed.
+  RunnerOptions o = fake_options(dir / "s.db", first_case_fails_after(300ms), 2);
   o.fail_fast = true;
   o.case_time_limit_s = 0.1;
   const RunnerReport r = run_study(study, o);
