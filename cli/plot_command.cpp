@@ -92,7 +92,9 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
 
   Store store = Store::open_reader(opt.db_path);
   const std::vector<CaseRecord> cases = read_case_records(store);
-  const std::string own_name = study_name(store, "study");
+  const std::string own_label = study_field_label(store);
+  const std::string own_name =
+      study_name(store, "study") + (own_label.empty() ? std::string() : " (" + own_label + ")");
   std::vector<const CaseRecord*> cdf_cases;
   for (std::int64_t index : opt.cdf_cases) {
     const auto it = std::find_if(cases.begin(), cases.end(),

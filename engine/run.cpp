@@ -1,6 +1,7 @@
 #include "engine/run.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -87,7 +88,8 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
   };
   maybe_output();
   const double snap_interval = obs ? obs->snapshot_interval_s() : 0.0;
-  double next_snap = snap_interval;
+  // On the same grid of times whether the run started fresh or from a checkpoint.
+  double next_snap = snap_interval > 0.0 ? snap_interval * (std::floor(sim.time() / snap_interval + 1e-9) + 1.0) : 0.0;
 
   const bool watch_stall = scene.gate_length > 0 && scene.has(Effect::drive) && scene.drive_speed > 0;
   GateStallWatch stall;

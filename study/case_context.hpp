@@ -82,6 +82,10 @@ class CaseContext {
   // Where the case writes its side views (empty: none).
   void set_views_dir(std::filesystem::path dir) { views_dir_ = std::move(dir); }
   const std::filesystem::path& views_dir() const { return views_dir_; }
+  // > 0: the case also measures its field every this many simulated seconds
+  // (Study::measure_interval_s).
+  void set_measure_interval(double s) { measure_interval_s_ = s; }
+  double measure_interval_s() const { return measure_interval_s_; }
   // Whether the case also keeps its final particles there (case_NNN_particles.bin).
   void set_keep_particles(bool keep) { keep_particles_ = keep; }
   bool keep_particles() const { return keep_particles_; }
@@ -98,8 +102,15 @@ class CaseContext {
   double checkpoint_interval_s_ = 0.0;
   std::filesystem::path views_dir_;
   bool keep_particles_ = false;
+  double measure_interval_s_ = 0.0;
   std::function<void(const std::string&)> warn_;
 };
+
+// Where a case keeps the field it measured over time while it has a checkpoint, so that a
+// resumed case stores the whole series.
+inline std::filesystem::path over_time_file(const std::filesystem::path& checkpoint) {
+  return checkpoint.string() + ".over_time.json";
+}
 
 // Runs one case; throws (SimulationError, InputError, anything) to fail it.
 using CaseFunction = std::function<CaseOutcome(const StudyCase&, CaseContext&)>;

@@ -116,8 +116,23 @@ std::string study_name(Store& store, const std::string& fallback) {
   return s.step() ? s.text(0) : fallback;
 }
 
+std::string study_field_label(Store& store) {
+  Statement s(store.handle(), "SELECT file_text, measurement_json FROM study WHERE id = 1");
+  if (!s.step()) return "";
+  const auto file = nlohmann::json::parse(s.text(0), nullptr, false);
+  const auto measurement = nlohmann::json::parse(s.text(1), nullptr, false);
+  std::string frame;
+  if (measurement.is_object() && measurement.contains("frame") && measurement.at("frame").is_string())
+    frame = measurement.at("frame").get<std::string>();
+  if (file.is_object() && file.contains("protocol") && file.at("protocol").is_string())
+    return file.at("protocol").get<std::string>() + " protocol, " + frame + " frame";
+  return frame.empty() ? "" : frame + " frame";
+}
+
 std::string study_title(Store& store) {
-  return "study '" + study_name(store, "?") + "' (" + store.path().string() + ")";
+  const std::string label = study_field_label(store);
+  return "study '" + study_name(store, "?") + "'" + (label.empty() ? "" : ", " + label) + " (" +
+         store.path().string() + ")";
 }
 
 }  // namespace crevasse

@@ -78,6 +78,9 @@ std::vector<CaseRecord> read_case_records(Store& store);
 
 // The study's name, or `fallback` when the database holds no study.
 std::string study_name(Store& store, const std::string& fallback);
+// What a figure or fit says it shows: "initiation protocol, draped frame" (a study that names its
+// protocol), "passed frame" (one that does not), or "" (no study row).
+std::string study_field_label(Store& store);
 
 // "study 'quick' (results/quick.db)".
 std::string study_title(Store& store);

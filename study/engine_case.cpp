@@ -11,6 +11,7 @@
 #include "engine/particle_file.hpp"
 #include "engine/run.hpp"
 #include "study/case_views.hpp"
+#include "study/field_over_time.hpp"
 #include "study/memory_reserve.hpp"
 #include "study/study_file.hpp"
 
@@ -19,7 +20,20 @@ namespace {
 
 class CaseObserver : public RunObserver {
  public:
-  explicit CaseObserver(CaseContext& ctx) : ctx_(ctx) {}
+  explicit CaseObserver(CaseContext& ctx)
+      : ctx_(ctx),
+        over_time_(ctx.checkpoint_file().empty() || ctx.measure_interval_s() <= 0
+                       ? std::filesystem::path()
+                       : over_time_file(ctx.checkpoint_file())) {}
+  double snapshot_interval_s() const override { return ctx_.measure_interval_s(); }
+  void on_snapshot(const ParticleSnapshot& s) override {
+    try {
+      over_time_.add(s, ctx_.measurement());
+    } catch (const std::invalid_argument& e) {
+      throw SimulationError(std::string("measurement at t = ") + std::to_string(s.time_s) + " s failed: " + e.what());
+    }
+  }
+  const FieldOverTime& over_time() const { return over_time_; }
   void on_progress(const RunProgress& p) override { ctx_.report_fraction(p.fraction_done); }
   bool cancelled() override {
     // A safe place to fail when an allocation had to take the memory reserve.
@@ -37,6 +51,7 @@ class CaseObserver : public RunObserver {
 
  private:
   CaseContext& ctx_;
+  FieldOverTime over_time_;
 };
 
 void check_finite(const ParticleSnapshot& s) {
@@ -146,6 +161,12 @@ CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx) {
       {"removed_mass_kg", r.removed_mass},    {"inflow_mass_kg", r.inflow_mass},
       {"initial_particles", r.initial_particles},
       {"final_particles", r.final_particles}, {"return_map_evaluations", r.return_map_evaluations}};
+  if (ctx.measure_interval_s() > 0) {
+    // The series ends with the final state, measured as the case's result is.
+    FieldOverTime series = observer.over_time();
+    series.add(r.final_snapshot, ctx.measurement());
+    out.result_extra["over_time"] = series.rows();
+  }
   // The whole run's wall time, its earlier sittings included (the checkpoint carries them);
   // stage_seconds are this sitting's. A format 2 checkpoint did not keep them: then the wall
   // times stored are this sitting's alone, and run_json says so.

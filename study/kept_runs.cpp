@@ -76,6 +76,7 @@ CaseOutcome KeptRuns::operator()(const StudyCase& study_case, CaseContext& ctx) 
   out.sim_time_s = result.at("sim_time_s").get<double>();
   out.result_extra = result.at("extra");
   out.result_extra.erase("other_spacing_rule");  // measured again below
+  out.result_extra.erase("over_time");  // taken in the old measurement's frame
   out.run_json = run;
   out.run_json.erase("peak_rss_exact");  // the runner's, for this process
   out.run_json["measured_from"] = {

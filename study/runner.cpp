@@ -266,6 +266,7 @@ class StudyRun {
     CaseContext ctx(threads, time_limit_, study_.measurement, stop(), progress_of_[slot]);
     if (!opt_.views_dir.empty()) ctx.set_views_dir(opt_.views_dir);
     ctx.set_keep_particles(opt_.keep_particles);
+    ctx.set_measure_interval(study_.measure_interval_s);
     ctx.set_warn([this, slot](const std::string& m) { queue_.push(Event{Event::Kind::warning, slot, {}, {}, m}); });
     std::filesystem::path checkpoint;
     if (study_.resources.checkpoint_interval_s > 0) {
@@ -308,8 +309,10 @@ class StudyRun {
     // end is final: nothing to continue from.
     if (!checkpoint.empty()) {
       std::error_code ec;
-      if (!out_of_time)
+      if (!out_of_time) {
         std::filesystem::remove(checkpoint, ec);
+        std::filesystem::remove(over_time_file(checkpoint), ec);
+      }
       else if (std::filesystem::is_regular_file(checkpoint, ec))
         failure += "; its checkpoint is kept: raise the limit and run again with --retry-failed to continue from it";
     }

@@ -451,6 +451,29 @@ void parse_resources(const ordered_json& doc, Study& st) {
   }
 }
 
+// "protocol" names the field a study measures and so its frame (docs/model.md, "Two
+// protocols"); "measure_interval_s" asks for the field over time as well.
+void parse_protocol(const ordered_json& doc, json& measurement, Study& st) {
+  if (doc.contains("measure_interval_s"))
+    st.measure_interval_s =
+        number_in(doc.at("measure_interval_s"), "measure_interval_s", {0.0, 1e6, false, false});
+  if (!doc.contains("protocol")) return;
+  const ordered_json& p = doc.at("protocol");
+  static const std::map<std::string, std::string> frame_of = {{"initiation", "draped"},
+                                                              {"steady", "passed"}};
+  const auto it = p.is_string() ? frame_of.find(p.get<std::string>()) : frame_of.end();
+  if (it == frame_of.end())
+    fail("protocol", "value " + p.dump() + R"( is not "initiation" or "steady")");
+  st.protocol = it->first;
+  if (!measurement.is_null() && !measurement.is_object()) return;  // refused as measurement below
+  if (!measurement.contains("frame")) {
+    measurement["frame"] = it->second;
+  } else if (measurement.at("frame") != it->second) {
+    fail("measurement.frame", "value " + measurement.at("frame").dump() + " is not the " + it->first +
+                                  " protocol's frame \"" + it->second + "\"; leave it out or set it so");
+  }
+}
+
 // The named parameters of a case (groups, ratios to H_i) written into its scene as the fields
 // they set (docs/study_format.md).
 void apply_named_parameters(json& scene, std::map<std::string, double>& named, const std::string& where,
@@ -576,11 +599,12 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
   if (!doc.is_object()) fail(source, "a study file must be a JSON object");
   refuse_unknown_keys(doc, "",
                  {"name", "description", "base_scene", "fixed", "sweep", "replicas", "measurement",
-                  "resources"});
+                  "resources", "protocol", "measure_interval_s"});
   parse_name_and_base(doc, base_dir, st);
   parse_parameters(doc, st);
-  st.measurement = measure_settings_from_json(
-      doc.contains("measurement") ? json(doc.at("measurement")) : json());
+  json measurement = doc.contains("measurement") ? json(doc.at("measurement")) : json();
+  parse_protocol(doc, measurement, st);
+  st.measurement = measure_settings_from_json(measurement);
   st.measurement_json = measure_settings_to_json(st.measurement);
   parse_resources(doc, st);
 

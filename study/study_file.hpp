@@ -85,6 +85,15 @@ struct Study {
   analysis::MeasureSettings measurement;
   nlohmann::json measurement_json;  // canonical form of `measurement` (enters the case hash)
   StudyResources resources;
+  // Which field the study measures (docs/model.md, "Two protocols"): "initiation" (the draped
+  // frame, ice that lay over the step when the push began), "steady" (the passed frame, ice that
+  // flowed over the lip), or empty for a study that does not say. Labels the database's figures
+  // and fits; its frame is the measurement's default and no other frame is accepted with it.
+  std::string protocol;
+  // > 0: each case also measures its field every this many simulated seconds and stores the
+  // series in result_json.extra.over_time, to see when the field settles. Not part of a
+  // case's identity: the measurement at the end is the same with or without it.
+  double measure_interval_s = 0.0;
   std::vector<StudyCase> cases;
   std::string study_hash;  // SHA-256 of the sorted case ids: same cases ⇔ same study
 };

@@ -213,6 +213,9 @@ TEST(Cli, KilledCaseResumesFromItsCheckpoint) {
   nlohmann::json study = test::tiny_study(2, 20000, "ckpt");
   study["sweep"] = {{"cohesion_ratio", {0.3}}};
   study["resources"] = {{"checkpoint_interval_s", 0.2}};
+  // The field over time too: the resumed case's series must be the uninterrupted one, the rows
+  // before its checkpoint kept and those after taken on the same times.
+  study["measure_interval_s"] = 5.0;
   test::write_text(dir / "s.json", study.dump(2));
   const Result ref = run_cli(dir.path(), "study s.json --db ref.db --jobs 1 --threads-per-case 1 --quiet");
   ASSERT_EQ(ref.code, 0) << ref.err;
@@ -257,6 +260,14 @@ TEST(Cli, KilledCaseResumesFromItsCheckpoint) {
   EXPECT_EQ(walls, std::vector<std::string>{"1|1|1"});
   EXPECT_TRUE(std::filesystem::is_empty(dir / "k.db.checkpoints"));
   EXPECT_EQ(test::result_dump(dir / "k.db"), test::result_dump(dir / "ref.db"));
+  const auto times = test::dump_rows(
+      dir / "ref.db",
+      "SELECT group_concat(round(json_extract(value, '$.time_s'))), max(json_extract(value, '$.time_s')) = "
+      "json_extract(result_json, '$.sim_time_s') FROM cases, json_each(json_extract(result_json, "
+      "'$.extra.over_time'))");
+  ASSERT_EQ(times.size(), 1u);
+  EXPECT_EQ(times[0].substr(0, 16), "5.0,10.0,15.0,20") << "a row every 5 s of simulated time";
+  EXPECT_EQ(times[0].substr(times[0].size() - 2), "|1") << "the last row is the final state";
 }
 
 // A case that runs out of time keeps its checkpoint: the failure says so, and under a larger

@@ -187,6 +187,28 @@ TEST(StudyFile, ResourcesAndMeasurementSettings) {
   EXPECT_NE(g.study_hash, s.study_hash);
 }
 
+// A protocol names the frame its field is measured in; the frame it implies is the one written, so
+// a study that names it keeps the case ids of one that sets the frame by hand.
+TEST(StudyFile, ProtocolSetsItsFrameAndKeepsTheCaseIds) {
+  json j = base_study();
+  j["protocol"] = "initiation";
+  const Study initiation = parse(j);
+  EXPECT_EQ(initiation.protocol, "initiation");
+  EXPECT_EQ(initiation.measurement.frame, "draped");
+  j["protocol"] = "steady";
+  const Study steady = parse(j);
+  EXPECT_EQ(steady.measurement.frame, "passed");
+  json by_hand = base_study();
+  by_hand["measurement"] = {{"frame", "passed"}};
+  EXPECT_EQ(parse(by_hand).study_hash, steady.study_hash);
+  EXPECT_NE(initiation.study_hash, steady.study_hash);
+  // The series over time is a record of the run, not part of the case.
+  j["measure_interval_s"] = 10;
+  const Study with_series = parse(j);
+  EXPECT_EQ(with_series.measure_interval_s, 10.0);
+  EXPECT_EQ(with_series.study_hash, steady.study_hash);
+}
+
 // Each mistake gets its own message naming the field (and the value and range where there is one).
 struct BadStudy {
   const char* what;
@@ -218,6 +240,16 @@ const BadStudy kBadStudies[] = {
      {"sweep.cohesion_ratio.log", "-0.1", "(0, inf)"}},
     {"unknown measurement frame", [](json& j) { j["measurement"] = {{"frame", "sideways"}}; },
      {"measurement.frame", "\"sideways\"", "'passed' or 'draped'"}},
+    {"unknown protocol", [](json& j) { j["protocol"] = "start"; },
+     {"protocol", "\"start\"", "\"initiation\" or \"steady\""}},
+    {"a frame the protocol does not measure",
+     [](json& j) {
+       j["protocol"] = "initiation";
+       j["measurement"] = {{"frame", "passed"}};
+     },
+     {"measurement.frame", "\"passed\"", "initiation protocol's frame \"draped\""}},
+    {"negative measure interval", [](json& j) { j["measure_interval_s"] = -1; },
+     {"measure_interval_s", "-1", "[0, 1000000]"}},
     {"count_gaps not a boolean", [](json& j) { j["measurement"] = {{"count_gaps", "yes"}}; },
      {"measurement.count_gaps", "\"yes\"", "true or false"}},
     {"log range with zero",
