@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "analysis/cracks_under_skin.hpp"
 #include "analysis/damage_clusters.hpp"
 #include "analysis/damage_criterion.hpp"
 #include "analysis/opened_gaps.hpp"
@@ -64,6 +65,7 @@ struct ClusterTally {
   double surface_x_sum = 0.0;
   double surface_x_min = std::numeric_limits<double>::infinity();
   double surface_x_max = -std::numeric_limits<double>::infinity();
+  bool under_skin = false;  // an opening of a cluster read as cracks under a damaged skin
 };
 
 // A crevasse during merging: its x-extent at the surface is kept to form the union.
@@ -187,6 +189,7 @@ ResolvedMeasureSettings resolve_in_frame(const ParticleSnapshot& snapshot,
                                 "\" is not \"merge\" or \"drop\"");
   r.spacing_rule = settings.spacing_rule;
   r.count_gaps = settings.count_gaps && !gate;
+  r.split_under_skin = settings.split_under_skin;
   r.min_depth_m = settings.min_depth_over_dx * r.dx_m;
   r.link_distance_m = settings.link_distance_over_spacing * r.particle_spacing_m;
   r.surface_reach_m = settings.surface_reach_over_dx * r.dx_m;
@@ -385,9 +388,27 @@ CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
   std::vector<ClusterTally> tally;
   std::vector<std::size_t> first(clusters.count + 1, 0);
   std::vector<std::vector<double>> bounds(clusters.count);
+  // Under a damaged skin, each crack is an opening of its own, at the surface above it. The
+  // skin is ice: its cracks are as deep as they reach below its top, the surface of all the
+  // particles (the profile above is of the intact ones, the skin's base).
+  SurfaceProfile skin_top;
+  std::vector<std::vector<std::pair<double, double>>> cracks(clusters.count);
+  if (r.split_under_skin) {
+    skin_top = compute_surface_profile(px, pz, std::vector<std::uint8_t>(px.size(), 0),
+                                       {.bin_width_m = r.dx_m,
+                                        .bridge_half_width_m = r.surface_bridge_half_width_m,
+                                        .smoothing_bins = r.surface_smoothing_bins,
+                                        .particle_half_extent_m = half_spacing});
+    cracks = cracks_under_skin(px, pz, clusters, skin_top, m.surface.x0_m, top_bin, r.min_depth_m);
+  }
   for (std::size_t c = 0; c < clusters.count; ++c) {
     first[c] = tally.size();
     auto& xs = surface_x[c];
+    if (!cracks[c].empty())
+      std::erase_if(xs, [&](double x) {
+        return std::none_of(cracks[c].begin(), cracks[c].end(),
+                            [x](const auto& k) { return x >= k.first && x < k.second; });
+      });
     if (xs.empty()) continue;
     std::sort(xs.begin(), xs.end());
     auto& tops = top_x[c];
@@ -395,7 +416,12 @@ CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
     for (std::size_t i = 1; i < tops.size(); ++i)
       if (tops[i] - tops[i - 1] > r.link_distance_m && intact_between(tops[i - 1], tops[i]))
         bounds[c].push_back(0.5 * (tops[i] + tops[i - 1]));
+    for (std::size_t i = 1; i < cracks[c].size(); ++i)
+      bounds[c].push_back(0.5 * (cracks[c][i - 1].second + cracks[c][i].first));
+    std::sort(bounds[c].begin(), bounds[c].end());
     tally.resize(tally.size() + bounds[c].size() + 1);
+    if (!cracks[c].empty())
+      for (std::size_t k = first[c]; k < tally.size(); ++k) tally[k].under_skin = true;
     for (double x : xs) {
       const auto k = static_cast<std::size_t>(std::upper_bound(bounds[c].begin(), bounds[c].end(), x) -
                                               bounds[c].begin());
@@ -437,7 +463,8 @@ CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
     const double x_left_lip = c.left_m - r.lip_offset_m, x_right_lip = c.right_m + r.lip_offset_m;
     const double t_lip = (c.crevasse.x_m - x_left_lip) / (x_right_lip - x_left_lip);
     c.crevasse.surface_z_m =
-        (1.0 - t_lip) * m.surface.height_at(x_left_lip) + t_lip * m.surface.height_at(x_right_lip);
+        t.under_skin ? skin_top.height_at(c.crevasse.x_m)
+                     : (1.0 - t_lip) * m.surface.height_at(x_left_lip) + t_lip * m.surface.height_at(x_right_lip);
     c.crevasse.bottom_z_m = t.z_min - half_spacing;
     // At most the ice's thickness (full depth): in the gate frame a layer damaged along the bed
     // may link to ice that started on the ramp, below the plateau's bed.

@@ -59,6 +59,12 @@ struct MeasureSettings {
   // opened leaves intact ice on either side and empty cells between them, which the damaged
   // particles alone do not link (docs/measurement.md, "Opened gaps").
   bool count_gaps = false;
+  // Whether one damaged cluster that reaches the surface along a damaged skin (a surface layer
+  // that lost its strength as the ice stretched) is read as the separate cracks that hang
+  // from it: under the skin, each run of surface bins where the cluster reaches at least
+  // min_depth below the surface is a crevasse of its own (docs/measurement.md, "Cracks under a
+  // damaged skin"). Off: the whole cluster is one crevasse, its deepest crack's depth.
+  bool split_under_skin = false;
   // A crevasse shallower than this is not resolved either (a damaged lens one or two particle
   // rows under the surface cannot be told from an opening at this resolution): not counted,
   // and counted in shallow_count instead. 0 counts every surface-reaching cluster.
@@ -105,6 +111,7 @@ struct ResolvedMeasureSettings {
   double resolution_floor_m = 0.0;
   std::string spacing_rule = "merge";
   bool count_gaps = false;
+  bool split_under_skin = false;
   double min_depth_m = 0.0;
   double link_distance_m = 0.0;
   double surface_reach_m = 0.0;

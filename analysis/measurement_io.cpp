@@ -77,6 +77,7 @@ nlohmann::json settings_to_json(const ResolvedMeasureSettings& s) {
       {"dim", s.dim},
   };
   if (s.count_gaps) j["count_gaps"] = true;  // absent when off, so stored results stay as they were
+  if (s.split_under_skin) j["split_under_skin"] = true;
   if (s.dim == 3) {
     j["y_band_center_m"] = s.y_band_center_m;
     j["y_band_width_m"] = s.y_band_width_m;

@@ -257,7 +257,7 @@ analysis::MeasureSettings measure_settings_from_json(const json& j) {
   const ordered_json o = j;
   refuse_unknown_keys(o, "measurement",
                  {"frame", "damage_threshold", "eps_v_p_threshold", "window_min_x_m", "window_max_x_m",
-                  "window_margin_over_h", "resolution_floor_over_dx", "spacing_rule", "count_gaps", "min_depth_over_dx", "link_distance_over_spacing",
+                  "window_margin_over_h", "resolution_floor_over_dx", "spacing_rule", "count_gaps", "split_under_skin", "min_depth_over_dx", "link_distance_over_spacing",
                   "surface_reach_over_dx", "surface_smoothing_bins",
                   "surface_bridge_half_width_over_h", "fragmented_fraction", "y_band_width_over_dx",
                   "y_band_center_m", "dx_m", "ice_thickness_m", "particle_spacing_m"});
@@ -293,6 +293,12 @@ analysis::MeasureSettings measure_settings_from_json(const json& j) {
     if (!o.at("count_gaps").is_boolean())
       fail("measurement.count_gaps", "value " + o.at("count_gaps").dump() + " is not true or false");
     s.count_gaps = o.at("count_gaps").get<bool>();
+  }
+  if (o.contains("split_under_skin")) {
+    if (!o.at("split_under_skin").is_boolean())
+      fail("measurement.split_under_skin",
+           "value " + o.at("split_under_skin").dump() + " is not true or false");
+    s.split_under_skin = o.at("split_under_skin").get<bool>();
   }
   num("min_depth_over_dx", s.min_depth_over_dx, {0.0, 100.0, false, false});
   num("link_distance_over_spacing", s.link_distance_over_spacing, {0.0, 10.0, true, false});
@@ -340,6 +346,7 @@ json measure_settings_to_json(const analysis::MeasureSettings& s) {
   // Written only when not the default, so that the case hashes of every stored study stay.
   if (s.spacing_rule != "merge") j["spacing_rule"] = s.spacing_rule;
   if (s.count_gaps) j["count_gaps"] = true;
+  if (s.split_under_skin) j["split_under_skin"] = true;
   return j;
 }
 

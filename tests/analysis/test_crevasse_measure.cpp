@@ -351,6 +351,46 @@ TEST(MeasureBranched, BranchedCrevasseHasACrevasseAtEachArm) {
   EXPECT_NEAR(m.crevasses[0].x_m, 502.5, h);
   EXPECT_NEAR(m.crevasses[1].x_m, 562.5, h);
   for (const Crevasse& c : m.crevasses) EXPECT_NEAR(c.depth_m, 80.0, h);
+  // Its arms' root lies deeper than the depth floor: no skin, and split_under_skin reads it alike.
+  MeasureSettings under;
+  under.split_under_skin = true;
+  const CrevasseMeasurement u = measure_crevasses(s, under);
+  ASSERT_EQ(u.crevasses.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(u.crevasses[k].x_m, m.crevasses[k].x_m);
+    EXPECT_EQ(u.crevasses[k].depth_m, m.crevasses[k].depth_m);
+  }
+}
+
+// A row of cracks hanging from a damaged skin (the top 10 m lost its strength from 395 to 610 m):
+// one cluster that meets the surface all along the row. As it stands it is one crevasse; read
+// under the skin (split_under_skin), each crack is a crevasse at its own position and depth.
+TEST(MeasureSkin, CracksUnderADamagedSkinAreCrevassesOfTheirOwnWhenAsked) {
+  SlabSpec spec;
+  const double h = test::spacing_of(spec);
+  std::vector<Notch> row;
+  const std::vector<double> depths = {45.0, 60.0, 40.0, 55.0, 45.0};
+  for (std::size_t k = 0; k < depths.size(); ++k)
+    row.push_back({.x_m = 402.5 + 50.0 * static_cast<double>(k), .depth_m = depths[k]});
+  ParticleSnapshot s = make_slab(spec, row);
+  damage_box(s, spec, 395.0, 610.0, spec.thickness_m - 10.0, spec.thickness_m);
+  const CrevasseMeasurement one = measure_crevasses(s);
+  EXPECT_EQ(one.cluster_count, 1u);
+  ASSERT_EQ(one.crevasses.size(), 1u);
+  EXPECT_NEAR(one.crevasses[0].depth_m, 60.0, h);
+
+  MeasureSettings under;
+  under.split_under_skin = true;
+  const CrevasseMeasurement split = measure_crevasses(s, under);
+  ASSERT_EQ(split.crevasses.size(), depths.size());
+  for (std::size_t k = 0; k < depths.size(); ++k) {
+    EXPECT_NEAR(split.crevasses[k].x_m, 402.5 + 50.0 * static_cast<double>(k), h) << k;
+    EXPECT_NEAR(split.crevasses[k].depth_m, depths[k], h) << k;
+  }
+  for (double spacing : split.spacings_m) EXPECT_NEAR(spacing, 50.0, h);
+  // Separate cracks without a skin are read the same either way.
+  const ParticleSnapshot bare = make_slab(spec, row);
+  EXPECT_EQ(measure_crevasses(bare, under).crevasses.size(), measure_crevasses(bare).crevasses.size());
 }
 
 TEST(MeasureSlope, DepthIsRelativeToTheLocalSurfaceOnASlope) {
