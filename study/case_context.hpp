@@ -82,9 +82,9 @@ class CaseContext {
   // Where the case writes its side views (empty: none).
   void set_views_dir(std::filesystem::path dir) { views_dir_ = std::move(dir); }
   const std::filesystem::path& views_dir() const { return views_dir_; }
-  // Whether the case also keeps its final particles there (case_NNN_particles.bin).
-  void set_keep_particles(bool keep) { keep_particles_ = keep; }
-  bool keep_particles() const { return keep_particles_; }
+  // Where the case keeps its final particles (case_NNN_particles.bin; empty: nowhere).
+  void set_particles_dir(std::filesystem::path dir) { particles_dir_ = std::move(dir); }
+  const std::filesystem::path& particles_dir() const { return particles_dir_; }
 
  private:
   int threads_;
@@ -97,7 +97,7 @@ class CaseContext {
   std::filesystem::path checkpoint_file_;
   double checkpoint_interval_s_ = 0.0;
   std::filesystem::path views_dir_;
-  bool keep_particles_ = false;
+  std::filesystem::path particles_dir_;
   std::function<void(const std::string&)> warn_;
 };
 
