@@ -201,9 +201,11 @@ TEST(Remeasure, ADamagedFileFailsOnlyItsCaseAndAStrayFileIsAWarning) {
   kept_study(dir, 3);
   const fs::path p = dir / "kept.db.particles";
   std::string bytes = slurp(p / "case_001_particles.bin");
-  const std::size_t at = bytes.find("\"gate_passed_length_m\":");
+  const std::string field = "\"ice_front_x_m\":";
+  const std::size_t at = bytes.find(field);
   ASSERT_NE(at, std::string::npos);
-  bytes[at + 24] ^= 0x01;  // one digit of the value: valid JSON, another measurement window
+  ASSERT_TRUE(std::isdigit(bytes[at + field.size() + 1])) << bytes.substr(at, 40);
+  bytes[at + field.size() + 1] ^= 0x01;  // its second digit: valid JSON, another front
   spill(p / "case_001_particles.bin", bytes);
   bytes = slurp(p / "case_002_particles.bin");
   spill(p / "case_002_particles.bin", bytes.substr(0, bytes.size() / 2));
