@@ -1,6 +1,7 @@
 #include "study/kept_runs.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <set>
 
 #include "engine/error.hpp"
@@ -25,7 +26,7 @@ std::optional<std::size_t> kept_particles_case_index(const std::filesystem::path
   const std::string head = "case_";
   if (!ends_with_tail(name) || name.compare(0, head.size(), head) != 0) return std::nullopt;
   const std::string digits = name.substr(head.size(), name.size() - head.size() - kTail.size());
-  if (digits.empty() || digits.size() > 9 || !std::all_of(digits.begin(), digits.end(), ::isdigit)) return std::nullopt;
+  if (digits.empty() || digits.size() > 9 || !std::all_of(digits.begin(), digits.end(), [](unsigned char c) { return std::isdigit(c) != 0; })) return std::nullopt;
   return static_cast<std::size_t>(std::stoul(digits));
 }
 

@@ -7,7 +7,7 @@
 // id). The run's record (stop reason, steps, simulated time, masses) comes from the kept study's
 // database, so a case measured this way stores the result a full run would store.
 #include <filesystem>
-#include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
