@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <iterator>
 #include <limits>
 #include <stdexcept>
@@ -93,6 +94,23 @@ std::string measure_frame_names() {
   return out;
 }
 
+void check_measure_scales(const MeasureSettings& settings, const MeasureScales& run) {
+  const auto within = [](const std::optional<double>& value, double scale, const char* key, const char* symbol) {
+    if (!value || !(scale > 0.0)) return;
+    const double lo = scale / kMeasureScaleFactor, hi = scale * kMeasureScaleFactor;
+    if (!(*value >= lo && *value <= hi)) {
+      char text[320];
+      std::snprintf(text, sizeof text,
+                    "%s = %.6g m is outside [%s/4, 4 %s] = [%.6g, %.6g] m of the run it measures (%s = %.6g m)", key,
+                    *value, symbol, symbol, lo, hi, symbol, scale);
+      throw std::invalid_argument(text);
+    }
+  };
+  within(settings.dx_m, run.dx_m, "dx_m", "dx");
+  within(settings.ice_thickness_m, run.ice_thickness_m, "ice_thickness_m", "H_i");
+  within(settings.particle_spacing_m, run.particle_spacing_m, "particle_spacing_m", "spacing");
+}
+
 bool uses_gate_frame(const ParticleSnapshot& snapshot, const MeasureSettings& settings) {
   require(is_measure_frame(settings.frame),
           "frame must be " + measure_frame_names() + ", got '" + settings.frame + "'");
@@ -168,6 +186,11 @@ ResolvedMeasureSettings resolve_in_frame(const ParticleSnapshot& snapshot,
   if (has_particles) {
     require_positive(r.particle_spacing_m,
                      "particle spacing (snapshot particle_spacing_m or MeasureSettings)");
+    check_measure_scales(settings, {snapshot.dx_m, snapshot.ice_thickness_m, snapshot.particle_spacing_m});
+    const auto [lo, hi] = std::minmax_element(snapshot.x.begin(), snapshot.x.end());
+    require((*hi - *lo) / r.dx_m <= kMaxMeasureBins,
+            "dx_m = " + std::to_string(r.dx_m) + " m would cut the particles' " + std::to_string(*hi - *lo) +
+                " m into more than 1e6 bins");
   }
 
   require_non_negative(settings.resolution_floor_over_dx, "resolution_floor_over_dx");
@@ -175,8 +198,11 @@ ResolvedMeasureSettings resolve_in_frame(const ParticleSnapshot& snapshot,
   require_positive(settings.link_distance_over_spacing, "link_distance_over_spacing");
   require_non_negative(settings.surface_reach_over_dx, "surface_reach_over_dx");
   require_non_negative(settings.window_margin_over_h, "window_margin_over_h");
-  require_non_negative(settings.surface_bridge_half_width_over_h,
-                       "surface_bridge_half_width_over_h");
+  // Up to H_i either side: an opening wider than twice the ice is no crevasse, and the bridging's
+  // work grows with the square of its width in bins.
+  require(settings.surface_bridge_half_width_over_h >= 0.0 && settings.surface_bridge_half_width_over_h <= 1.0,
+          "surface_bridge_half_width_over_h must lie in [0, 1], got " +
+              std::to_string(settings.surface_bridge_half_width_over_h));
   require(settings.surface_smoothing_bins >= 1 && settings.surface_smoothing_bins % 2 == 1,
           "surface_smoothing_bins must be an odd number >= 1 (centred average), got " +
               std::to_string(settings.surface_smoothing_bins));
@@ -236,7 +262,7 @@ ResolvedMeasureSettings resolve_in_frame(const ParticleSnapshot& snapshot,
 }
 
 CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
-                                     const MeasureSettings& settings, bool gate);
+                                     const MeasureSettings& settings, bool gate, const MeasurePoll& poll);
 
 }  // namespace
 
@@ -248,16 +274,20 @@ ResolvedMeasureSettings resolve_measure_settings(const ParticleSnapshot& snapsho
 }
 
 CrevasseMeasurement measure_crevasses(const ParticleSnapshot& snapshot,
-                                      const MeasureSettings& settings) {
+                                      const MeasureSettings& settings, const MeasurePoll& poll) {
   if (uses_gate_frame(snapshot, settings))
-    return measure_in_frame(gate_frame_snapshot(snapshot), settings, true);
-  return measure_in_frame(snapshot, settings, false);
+    return measure_in_frame(gate_frame_snapshot(snapshot), settings, true, poll);
+  return measure_in_frame(snapshot, settings, false, poll);
 }
 
 namespace {
 
 CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
-                                     const MeasureSettings& settings, bool gate) {
+                                     const MeasureSettings& settings, bool gate, const MeasurePoll& poll) {
+  const auto checkpoint = [&] {
+    if (poll) poll();
+  };
+  checkpoint();
   CrevasseMeasurement m;
   m.settings = resolve_in_frame(snapshot, settings, gate);
   m.time_s = snapshot.time_s;
@@ -300,7 +330,9 @@ CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
                                       {.bin_width_m = r.dx_m,
                                        .bridge_half_width_m = r.surface_bridge_half_width_m,
                                        .smoothing_bins = r.surface_smoothing_bins,
-                                       .particle_half_extent_m = half_spacing});
+                                       .particle_half_extent_m = half_spacing,
+                                       .poll = poll});
+  checkpoint();
 
   // Window occupancy and the share of it that is broken, for the "fragmented" flag.
   std::size_t window_damaged = 0;
@@ -338,8 +370,10 @@ CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
     pz.insert(pz.end(), gaps.z.begin(), gaps.z.end());
     damaged.insert(damaged.end(), gaps.x.size(), 1);
   }
-  const DamageClusters clusters = find_damage_clusters(px, pz, damaged, r.link_distance_m);
+  checkpoint();
+  const DamageClusters clusters = find_damage_clusters(px, pz, damaged, r.link_distance_m, poll);
   m.cluster_count = clusters.count;
+  checkpoint();
   // Each place where a damaged cluster meets the surface is a crevasse of its own: one cluster
   // may reach the surface at several openings separated by intact surface, when crevasses branch
   // from one root or are joined at depth (by a damaged layer along the bed, say). A cluster's

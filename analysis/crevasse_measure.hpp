@@ -2,6 +2,7 @@
 // Crevasse positions, depths and spacings from a particle snapshot.
 // Definitions and the reasons for each default: docs/measurement.md.
 #include <cstddef>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -176,12 +177,33 @@ struct CrevasseMeasurement {
   SurfaceProfile surface;
 };
 
+// The scales of the run a measurement reads. Every length a measurement resolves is tied to them,
+// so that no setting can ask for a resolution or thickness the run does not have (and with it an
+// unbounded amount of work): dx_m, ice_thickness_m and particle_spacing_m lie within a factor
+// kMeasureScaleFactor of the run's own, and the profile has at most kMaxMeasureBins bins along
+// the particles' extent. A scale of 0 is unknown and bounds nothing.
+struct MeasureScales {
+  double dx_m = 0.0;
+  double ice_thickness_m = 0.0;
+  double particle_spacing_m = 0.0;
+};
+inline constexpr double kMeasureScaleFactor = 4.0;
+inline constexpr double kMaxMeasureBins = 1e6;
+// Throws std::invalid_argument naming the setting, its value and the range the run allows.
+void check_measure_scales(const MeasureSettings& settings, const MeasureScales& run);
+
+// Called now and then while measuring (between stages, and every few thousand steps of the
+// longer loops). A caller that has to stop (a time limit, a signal) throws from it, and the
+// measurement is abandoned with that exception. Empty: never called.
+using MeasurePoll = std::function<void()>;
+
 // Throws std::invalid_argument with the offending field when the snapshot's arrays disagree in
-// length, hold non-finite positions, or dx / H_i are unknown while particles are present.
+// length, hold non-finite positions, or dx / H_i are unknown while particles are present, or a
+// setting is out of the run's scales (check_measure_scales).
 ResolvedMeasureSettings resolve_measure_settings(const ParticleSnapshot& snapshot,
                                                  const MeasureSettings& settings);
 CrevasseMeasurement measure_crevasses(const ParticleSnapshot& snapshot,
-                                      const MeasureSettings& settings = {});
+                                      const MeasureSettings& settings = {}, const MeasurePoll& poll = {});
 
 // The gate records of a snapshot as a snapshot of their own: each recorded particle at its
 // initial position with the ε_v^p it had at the gate (velocities and stresses zero). Metadata

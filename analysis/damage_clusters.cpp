@@ -39,7 +39,8 @@ class DisjointSets {
 }  // namespace
 
 DamageClusters find_damage_clusters(std::span<const double> x, std::span<const double> z,
-                                    std::span<const std::uint8_t> damaged, double link_distance_m) {
+                                    std::span<const std::uint8_t> damaged, double link_distance_m,
+                                    const std::function<void()>& poll) {
   if (x.size() != z.size() || x.size() != damaged.size()) {
     throw std::invalid_argument("damage clusters: x, z and damage arrays differ in length");
   }
@@ -87,7 +88,8 @@ DamageClusters find_damage_clusters(std::span<const double> x, std::span<const d
   // Each unordered pair of cells is visited once: the cell itself and four forward neighbours.
   constexpr int kForward[4][2] = {{0, 1}, {1, -1}, {1, 0}, {1, 1}};
   std::size_t begin = 0;
-  while (begin < order.size()) {
+  for (std::size_t cells = 0; begin < order.size(); ++cells) {
+    if (poll && cells % 1024 == 0) poll();
     std::size_t end = begin;
     while (end < order.size() && sorted_key[end] == sorted_key[begin]) ++end;
     for (std::size_t i = begin; i < end; ++i) {

@@ -3,6 +3,7 @@
 // belong to the same region when a chain of damaged particles links them with steps no longer
 // than the link distance. Union-find over a cell hash, O(N log N) in the damaged count.
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -14,7 +15,9 @@ struct DamageClusters {
   std::size_t count = 0;            // clusters are numbered 0 .. count-1
 };
 
+// `poll` is called every thousand cells and may throw to abandon the search (MeasurePoll).
 DamageClusters find_damage_clusters(std::span<const double> x, std::span<const double> z,
-                                    std::span<const std::uint8_t> damaged, double link_distance_m);
+                                    std::span<const std::uint8_t> damaged, double link_distance_m,
+                                    const std::function<void()>& poll = {});
 
 }  // namespace crevasse::analysis

@@ -40,10 +40,11 @@ std::vector<double> top_per_bin(std::span<const double> x, std::span<const doubl
 // Local upper envelope by chords: z_i ← max(z_i, chords between measured bins a < i < b within
 // ±w bins). A crevasse dip sits below the chord joining its lips and is lifted to it; a
 // straight or convex surface lies on or above every such chord and is unchanged.
-std::vector<double> bridge_dips(const std::vector<double>& top, std::size_t w) {
+std::vector<double> bridge_dips(const std::vector<double>& top, std::size_t w, const std::function<void()>& poll) {
   const std::size_t n = top.size();
   std::vector<double> out = top;
   for (std::size_t i = 1; i + 1 < n; ++i) {
+    if (poll && i % 256 == 0) poll();
     const std::size_t a0 = i >= w ? i - w : 0;
     const std::size_t b1 = std::min(n - 1, i + w);
     for (std::size_t a = a0; a < i; ++a) {
@@ -127,7 +128,7 @@ SurfaceProfile compute_surface_profile(std::span<const double> x, std::span<cons
 
   const auto w = static_cast<std::size_t>(
       std::max(1.0, std::ceil(settings.bridge_half_width_m / settings.bin_width_m)));
-  std::vector<double> bridged = bridge_dips(top, w);
+  std::vector<double> bridged = bridge_dips(top, w, settings.poll);
   for (std::size_t i = 0; i < n_bins; ++i) {
     // A micrometre margin keeps round-off on a straight slope from counting as a bridged dip.
     if (top[i] != kMissing && bridged[i] > top[i] + 1e-6) profile.measured[i] = 0;

@@ -3,6 +3,7 @@
 // per x-bin the highest undamaged particle, with dips bridged so that an open or damaged
 // crevasse does not pull the surface down into itself, then smoothed.
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -18,6 +19,9 @@ struct SurfaceSettings {
   // Particles stand for a volume of this half-size: the material surface lies this far above
   // the top particle centre.
   double particle_half_extent_m = 0.0;
+  // Called every few thousand bins of the bridging, whose work grows with the square of the
+  // bridge's width in bins; it throws to abandon the profile (MeasurePoll).
+  std::function<void()> poll;
 };
 
 struct SurfaceProfile {

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <cstdio>
 #include <cstring>
 
@@ -36,8 +37,14 @@ void check_output_directory(const std::string& option, const fs::path& dir,
   if (!fs::is_directory(existing, ec))
     throw InputError(option + ": " + existing.string() + " exists and is not a folder" +
                      (existing == wanted ? std::string() : ", so " + dir.string() + " cannot be made"));
-  if (::access(existing.c_str(), W_OK | X_OK) != 0)
+  // A file made and removed again: permission bits say nothing to root, and nothing at all
+  // about /proc or a read-only mount.
+  std::string probe = (existing / ".crevasse-probe-XXXXXX").string();
+  const int fd = ::mkstemp(probe.data());
+  if (fd < 0)
     throw InputError(option + ": cannot write in " + existing.string() + " (" + std::strerror(errno) + ")");
+  ::close(fd);
+  ::unlink(probe.c_str());
   for (const std::string& name : files) {  // a name ending in '/' is a folder
     const fs::path p = dir / name;
     if (!fs::exists(fs::symlink_status(p, ec))) continue;
@@ -54,6 +61,20 @@ void check_output_file(const std::string& option, const fs::path& file) {
   check_output_directory(option, parent);
   if (fs::exists(fs::symlink_status(file, ec)) && !fs::is_regular_file(fs::status(file, ec)))
     throw InputError(option + ": " + file.string() + " exists and is not a regular file");
+}
+
+bool same_path(const fs::path& a, const fs::path& b) {
+  std::error_code ec;
+  if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec);  // links of any kind
+  const fs::path ca = fs::weakly_canonical(fs::absolute(a, ec), ec), cb = fs::weakly_canonical(fs::absolute(b, ec), ec);
+  return !ec && ca == cb;
+}
+
+void check_output_is_not_input(const std::string& option, const fs::path& output, const std::vector<NamedPath>& inputs) {
+  for (const NamedPath& in : inputs)
+    if (same_path(output, in.path))
+      throw InputError(option + ": " + output.string() + " is also " + in.option + " (" + in.path.string() +
+                       "): a command never writes over what it reads; choose another path");
 }
 
 void check_confidence_level(double level) {

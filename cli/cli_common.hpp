@@ -28,6 +28,19 @@ void check_output_directory(const std::string& option, const std::filesystem::pa
 // The same for one output file: its folder as above, the file absent or a regular file.
 void check_output_file(const std::string& option, const std::filesystem::path& file);
 
+// Whether two paths name one file or folder once symbolic links are followed (and, when both
+// exist, whether they are hard links to one file).
+bool same_path(const std::filesystem::path& a, const std::filesystem::path& b);
+
+// No output of a command may be one of its inputs: InputError naming `option`, the path and the
+// input it would overwrite, when `output` is one of `inputs` (same_path).
+struct NamedPath {
+  std::string option;
+  std::filesystem::path path;
+};
+void check_output_is_not_input(const std::string& option, const std::filesystem::path& output,
+                               const std::vector<NamedPath>& inputs);
+
 // --level of fit, calibrate and predict: in (0.5, 1), and below 1 as the tables show it (4
 // significant digits): a level that rounds to 1 has infinite intervals. InputError otherwise.
 void check_confidence_level(double level);

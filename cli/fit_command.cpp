@@ -155,9 +155,11 @@ int fit_command(const FitCommandOptions& opt) {
   std::optional<Store> opened;
   try {
     opened.emplace(Store::open_writer(opt.db_path, 10.0, ""));
+  } catch (const ResourceError& e) {  // a study writing it: busy, not bad input
+    throw ResourceError(opt.db_path + ": cannot store the fits (" + e.what() +
+                        "); run crevasse fit again when the study has ended, or add --no-store");
   } catch (const InputError& e) {
-    throw InputError(opt.db_path + ": cannot store the fits (" + e.what() +
-                     "); run crevasse fit again when the study has ended, or add --no-store");
+    throw InputError(opt.db_path + ": cannot store the fits (" + e.what() + ")");
   }
   Store& writer = *opened;
   std::vector<FitRecord> rows;

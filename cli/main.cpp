@@ -99,8 +99,9 @@ int run_command_line(int argc, char** argv) {
   study->add_flag("--quiet", study_opt.quiet, "No progress output");
   study->add_option("--views", study_opt.views_dir, "Folder for the side views of each case run (case_NNN_side_view.png, case_NNN_gate_view.png; NNN as in --dry-run)");
   study->add_option("--remeasure", study_opt.remeasure_db, "Measure the cases from the particles another study kept, instead of simulating them: that study's database (give --particles-from too)");
-  study->add_option("--particles-from", study_opt.particles_from, "With --remeasure: the --views folder where that study kept its particles");
-  study->add_flag("--keep-particles", study_opt.keep_particles, "Keep each case's final particles in the --views folder (case_NNN_particles.bin, about 1 MB per 40 000 particles), to measure again with crevasse measure");
+  study->add_option("--particles-from", study_opt.particles_from, "With --remeasure: the folder where that study kept its particles (its DB.particles/, or --particles-dir)");
+  study->add_flag("--keep-particles", study_opt.keep_particles, "Keep each case's final particles (case_NNN_particles.bin, about 1 MB per 40 000 particles) in DB.particles/ beside the database, to measure again with crevasse measure or --remeasure");
+  study->add_option("--particles-dir", study_opt.particles_dir, "Keep the final particles in this folder instead of DB.particles/ (implies --keep-particles)");
 
   crevasse::MeasureCommandOptions measure_opt;
   auto* measure = app.add_subcommand("measure", "Measure a case's final particles again (crevasse study --keep-particles, crevasse run), e.g. with other settings");

@@ -40,7 +40,7 @@ void print_measurement(const analysis::CrevasseMeasurement& m, const nlohmann::j
   const std::string id = meta.value("case_id", std::string()), label = meta.value("label", std::string());
   if (!id.empty()) std::printf("case %s  ", id.c_str());
   std::printf("%s\n", label.c_str());
-  std::printf("t = %.1f s  H_i = %.0f m  dx = %.3g m  frame %s  window %.0f-%.0f m  rule %s\n", m.time_s, h,
+  std::printf("t = %.1f s  H_i = %.4g m  dx = %.3g m  frame %s  window %.0f-%.0f m  rule %s\n", m.time_s, h,
               m.settings.dx_m, m.settings.frame.c_str(), m.settings.window_min_x_m, m.settings.window_max_x_m,
               m.settings.spacing_rule.c_str());
   std::printf("crevasses %zu  (shallower than %.3g m: %zu; spacings dropped under the floor: %zu)\n",
@@ -62,12 +62,24 @@ void print_measurement(const analysis::CrevasseMeasurement& m, const nlohmann::j
 }  // namespace
 
 int measure_command(const MeasureCommandOptions& opt) {
-  const std::filesystem::path out(opt.out_dir);
-  if (!opt.out_dir.empty())
-    check_output_directory("--out", out,
-                           {"crevasses.csv", "measurement.json", "side_view.png", "gate_view.png"});
-  if (!opt.vtu_path.empty()) check_output_file("--vtu", opt.vtu_path);
+  // Every output is checked before the particles are read: none may be the input, and each
+  // must be writable (its folder made below a writable one).
+  const std::filesystem::path out(opt.out_dir), vtu(opt.vtu_path);
+  const std::vector<std::string> out_files = {"crevasses.csv", "measurement.json", "side_view.png", "gate_view.png"};
+  std::vector<NamedPath> inputs = {{"the particle file", opt.particle_path}};
+  if (!opt.out_dir.empty()) {
+    check_output_directory("--out", out, out_files);
+    for (const std::string& name : out_files) check_output_is_not_input("--out", out / name, inputs);
+  }
+  if (!opt.vtu_path.empty()) {
+    check_output_file("--vtu", vtu);
+    if (!opt.out_dir.empty())
+      for (const std::string& name : out_files) inputs.push_back({"--out's " + name, out / name});
+    check_output_is_not_input("--vtu", vtu, inputs);
+  }
   const ParticleFile file = read_particle_file(opt.particle_path);
+  if (!file.header_checked)
+    std::fprintf(stderr, "crevasse: warning: %s\n", unchecked_header_warning(opt.particle_path).c_str());
   nlohmann::json measurement = file.metadata.value("measurement", nlohmann::json::object());
   if (!measurement.is_object()) measurement = nlohmann::json::object();
   for (const std::string& kv : opt.settings) apply_setting(measurement, kv);
@@ -80,9 +92,7 @@ int measure_command(const MeasureCommandOptions& opt) {
   }
   print_measurement(m, file.metadata);
   if (!opt.out_dir.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(out, ec);
-    if (ec) throw InputError("--out: cannot create directory " + out.string() + " (" + ec.message() + ")");
+    create_output_directory("--out", out);
     analysis::write_crevasses_csv(m, out / "crevasses.csv");
     analysis::write_measurement_summary(m, out / "measurement.json");
     const double rho = file.metadata.value("density_kg_m3", 0.0), g = file.metadata.value("gravity_m_s2", 0.0);
@@ -92,7 +102,10 @@ int measure_command(const MeasureCommandOptions& opt) {
                                 : 0.0;
     write_case_views(pi_group, s, m, out);
   }
-  if (!opt.vtu_path.empty()) write_vtu(opt.vtu_path, file.snapshot);
+  if (!opt.vtu_path.empty()) {
+    if (vtu.has_parent_path()) create_output_directory("--vtu", vtu.parent_path());
+    write_vtu(opt.vtu_path, file.snapshot);
+  }
   return 0;
 }
 

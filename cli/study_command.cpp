@@ -151,19 +151,6 @@ int study_command(const StudyCommandOptions& opt) {
   if (opt.remeasure_db.empty() != opt.particles_from.empty())
     throw InputError(opt.remeasure_db.empty() ? "--particles-from: give the kept study's database with --remeasure DB too"
                                               : "--remeasure: give the folder of its kept particles with --particles-from DIR too");
-  if (opt.keep_particles && opt.views_dir.empty())
-    throw InputError("--keep-particles: the particles are kept beside the side views; give --views DIR too");
-  if (!opt.views_dir.empty()) {
-    std::vector<std::string> views;
-    for (const StudyCase& c : study.cases) {
-      char stem[32];
-      std::snprintf(stem, sizeof stem, "case_%03zu_", c.index);
-      views.push_back(std::string(stem) + "side_view.png");
-      views.push_back(std::string(stem) + "gate_view.png");
-      if (opt.keep_particles) views.push_back(std::string(stem) + "particles.bin");
-    }
-    check_output_directory("--views", opt.views_dir, views);
-  }
   std::string db = opt.db_path;
   if (db.empty()) {
     db = "results/" + study.name;
@@ -171,6 +158,36 @@ int study_command(const StudyCommandOptions& opt) {
       db += ".shard-" + std::to_string(shard->index) + "-of-" + std::to_string(shard->count);
     db += ".db";
   }
+  // What the study reads, which none of its outputs may be, however spelt.
+  std::vector<NamedPath> inputs = {{"the study file", opt.study_path}};
+  std::shared_ptr<const KeptRuns> kept;
+  if (!opt.remeasure_db.empty()) {
+    kept = std::make_shared<const KeptRuns>(opt.remeasure_db, opt.particles_from);
+    inputs.push_back({"--remeasure", opt.remeasure_db});
+    inputs.push_back({"--particles-from", opt.particles_from});
+    for (const auto& f : kept->files()) inputs.push_back({"a file of --particles-from", f});
+  }
+  for (const char* suffix : {"", "-wal", "-shm"}) check_output_is_not_input("--db", db + suffix, inputs);
+  // Each folder of files named by case, checked as a whole and file by file.
+  const auto check_case_files = [&](const std::string& option, const std::filesystem::path& dir,
+                                    const std::vector<std::string>& tails) {
+    std::vector<std::string> names;
+    for (const StudyCase& c : study.cases) {
+      char stem[32];
+      std::snprintf(stem, sizeof stem, "case_%03zu_", c.index);
+      for (const std::string& tail : tails) names.push_back(stem + tail);
+    }
+    check_output_directory(option, dir, names);
+    check_output_is_not_input(option, dir, inputs);
+    for (const std::string& name : names) check_output_is_not_input(option, dir / name, inputs);
+  };
+  if (!opt.views_dir.empty()) check_case_files("--views", opt.views_dir, {"side_view.png", "gate_view.png"});
+  const bool keep_particles = opt.keep_particles || !opt.particles_dir.empty();
+  const std::filesystem::path particles_dir =
+      !keep_particles ? std::filesystem::path() : std::filesystem::path(opt.particles_dir.empty() ? db + ".particles" : opt.particles_dir);
+  if (keep_particles)
+    check_case_files(opt.particles_dir.empty() ? "--keep-particles" : "--particles-dir", particles_dir,
+                     {"particles.bin"});
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   const int threads_asked =
       opt.threads_per_case > 0 ? opt.threads_per_case : study.resources.threads_per_case;
@@ -190,9 +207,9 @@ int study_command(const StudyCommandOptions& opt) {
   ro.shard = shard;
   ro.command = opt.command_line;
   ro.views_dir = opt.views_dir;
-  ro.keep_particles = opt.keep_particles;
-  if (!opt.remeasure_db.empty()) {
-    auto kept = std::make_shared<const KeptRuns>(opt.remeasure_db, opt.particles_from);
+  ro.particles_dir = particles_dir;
+  if (kept) {
+    for (const std::string& w : kept->warnings(study)) console.warn(w);
     ro.case_function = [kept](const StudyCase& c, CaseContext& ctx) { return (*kept)(c, ctx); };
   }
   ro.observer = opt.quiet ? nullptr : &console;

@@ -17,7 +17,10 @@ struct StudyCommandOptions {
   bool dry_run = false;  // list the cases and their hashes; run nothing, create nothing
   bool quiet = false;
   std::string views_dir;  // non-empty: side views of every case run, case_NNN_side_view.png
-  bool keep_particles = false;  // also case_NNN_particles.bin in views_dir
+  // Keep each case's final particles (case_NNN_particles.bin) in particles_dir, by default
+  // DB.particles beside the database; a particles_dir implies keep_particles.
+  bool keep_particles = false;
+  std::string particles_dir;
   // Both or neither: measure the cases from the particles another study kept, with that
   // study's database for the runs' records, instead of simulating them (study/kept_runs.hpp).
   std::string remeasure_db;

@@ -12,6 +12,13 @@ class InputError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// The machine, not the input, stopped the command: a full disk, a file another process holds.
+// The message names the path and the remedy; the CLI exits with 1, never with 2.
+class ResourceError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 // The simulation went wrong (NaN, instability, time limit): the message says which step,
 // which particle and which quantity.
 class SimulationError : public std::runtime_error {

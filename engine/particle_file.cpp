@@ -7,6 +7,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <string>
 #include <stdexcept>
 
 #include "engine/atomic_file.hpp"
@@ -19,7 +20,10 @@ static_assert(std::endian::native == std::endian::little, "particle files are li
 
 constexpr char kMagic[8] = {'C', 'R', 'V', 'P', 'T', 'C', 'L', '\n'};
 constexpr char kEnd[8] = {'C', 'R', 'V', 'P', 'E', 'N', 'D', '\n'};
-constexpr std::uint32_t kFormat = 1;
+// Format 2: one CRC-32 over every byte before it, header included. Format 1 checked only its
+// arrays; it is still read, and the reader says that its header is unchecked.
+constexpr std::uint32_t kFormat = 2;
+constexpr std::uint32_t kFormatArraysOnly = 1;
 
 // Every per-particle and gate array, with the precision it is kept in: what the measurement
 // reads in double, what is only drawn in single.
@@ -45,6 +49,10 @@ constexpr ArraySlot kArrays[] = {
     {"gate_z_ref", &ParticleSnapshot::gate_z_ref, false},
     {"gate_eps_v_p", &ParticleSnapshot::gate_eps_v_p, false},
 };
+
+std::uint32_t file_crc(const char* data, std::size_t n) {
+  return static_cast<std::uint32_t>(crc32_z(0L, reinterpret_cast<const Bytef*>(data), n));
+}
 
 template <class T>
 void put(std::string& out, const T& v) {
@@ -111,7 +119,6 @@ void write_particle_file(const std::filesystem::path& path, const ParticleSnapsh
                 reinterpret_cast<const Bytef*>(raw.data()), raw.size(), 6) != Z_OK)
     throw std::runtime_error("cannot compress the particles for " + path.string());
   packed.resize(packed_size);
-  const std::uint32_t crc = crc32(0L, reinterpret_cast<const Bytef*>(raw.data()), raw.size());
 
   const std::string header_text = header.dump();
   std::string out(kMagic, sizeof kMagic);
@@ -120,81 +127,94 @@ void write_particle_file(const std::filesystem::path& path, const ParticleSnapsh
   out += header_text;
   put(out, static_cast<std::uint64_t>(raw.size()));
   put(out, static_cast<std::uint64_t>(packed.size()));
-  put(out, crc);
   out += packed;
+  put(out, file_crc(out.data(), out.size()));
   out.append(kEnd, sizeof kEnd);
   write_file_atomically(path, out);
 }
 
 namespace {
 
-// Opens a particle file and reads its prelude (magic, format, header size, header JSON text),
-// leaving the stream at the sizes that follow. Both readers share it, and so its refusals.
-std::string open_and_read_header(const std::filesystem::path& path, const std::string& where, std::ifstream& f) {
+// A whole particle file in memory, its prelude parsed and, for format 2, its checksum checked:
+// what both readers share, and so their refusals.
+struct RawFile {
+  std::uint32_t format = 0;
+  std::string header_text;
+  std::string bytes;          // the whole file
+  std::size_t packed_at = 0;  // where the compressed arrays start in `bytes`
+  std::uint64_t raw_size = 0, packed_size = 0;
+  std::uint32_t arrays_crc = 0;  // format 1 only: the CRC-32 of the uncompressed arrays
+};
+
+RawFile read_raw(const std::filesystem::path& path, const std::string& where) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     throw InputError(where + ": no such particle file (a regular file)");
-  const auto file_size = std::filesystem::file_size(path, ec);
-  f.open(path, std::ios::binary);
-  if (ec || !f) throw InputError(where + ": cannot read the particle file");
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw InputError(where + ": cannot read the particle file");
   char magic[sizeof kMagic];
   if (!f.read(magic, sizeof magic) || std::memcmp(magic, kMagic, sizeof kMagic) != 0)
     throw InputError(where + ": not a crevasse particle file");
-  std::uint32_t format = 0;
+  f.seekg(0);
+  RawFile r;
+  r.bytes.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+  if (!f.eof() && f.fail()) throw InputError(where + ": cannot read the particle file");
+  const std::string& b = r.bytes;
+  std::size_t at = sizeof kMagic;
+  auto need = [&](std::uint64_t n) {
+    if (n > b.size() - at) throw InputError(where + ": truncated particle file");
+  };
+  auto get = [&]<class T>(T& v) {
+    need(sizeof v);
+    std::memcpy(&v, b.data() + at, sizeof v);
+    at += sizeof v;
+  };
+  get(r.format);
+  if (r.format != kFormat && r.format != kFormatArraysOnly)
+    throw InputError(where + ": particle file format " + std::to_string(r.format) + " (this crevasse reads formats " +
+                     std::to_string(kFormatArraysOnly) + " and " + std::to_string(kFormat) + ")");
   std::uint64_t header_size = 0;
-  if (!f.read(reinterpret_cast<char*>(&format), sizeof format))
-    throw InputError(where + ": truncated particle file");
-  if (format != kFormat)
-    throw InputError(where + ": particle file format " + std::to_string(format) +
-                     " (this crevasse reads format " + std::to_string(kFormat) + ")");
-  if (!f.read(reinterpret_cast<char*>(&header_size), sizeof header_size) || header_size > file_size)
-    throw InputError(where + ": truncated particle file");
-  std::string header_text(header_size, '\0');
-  if (!f.read(header_text.data(), static_cast<std::streamsize>(header_size)))
-    throw InputError(where + ": truncated particle file");
-  return header_text;
+  get(header_size);
+  need(header_size);
+  r.header_text = b.substr(at, header_size);
+  at += header_size;
+  get(r.raw_size);
+  get(r.packed_size);
+  if (r.format == kFormatArraysOnly) get(r.arrays_crc);
+  need(r.packed_size);
+  r.packed_at = at;
+  at += r.packed_size;
+  if (r.format == kFormat) {
+    const std::size_t summed = at;
+    std::uint32_t crc = 0;
+    get(crc);
+    need(sizeof kEnd);
+    if (std::memcmp(b.data() + at, kEnd, sizeof kEnd) == 0 && at + sizeof kEnd == b.size() &&
+        file_crc(b.data(), summed) != crc)
+      throw InputError(where + ": damaged particle file (it fails its checksum)");
+  }
+  need(sizeof kEnd);
+  if (std::memcmp(b.data() + at, kEnd, sizeof kEnd) != 0 || at + sizeof kEnd != b.size())
+    throw InputError(where + ": damaged particle file (no end marker where its sizes put it)");
+  return r;
 }
 
 }  // namespace
 
 ParticleFile read_particle_file(const std::filesystem::path& path) {
   const std::string where = path.string();
-  std::ifstream f;
-  const std::string header_text = open_and_read_header(path, where, f);
-  const std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-  if (!f.eof() && f.fail()) throw InputError(where + ": cannot read the particle file");
-  std::size_t at = 0;
-  auto need = [&](std::size_t n) {
-    if (n > bytes.size() - at)
-      throw InputError(where + ": truncated particle file");
-  };
-  auto get = [&]<class T>(T& v) {
-    need(sizeof v);
-    std::memcpy(&v, bytes.data() + at, sizeof v);
-    at += sizeof v;
-  };
-  std::uint64_t raw_size = 0, packed_size = 0;
-  std::uint32_t crc = 0;
-  get(raw_size);
-  get(packed_size);
-  get(crc);
-  need(packed_size);
-  const std::size_t packed_at = at;
-  at += packed_size;
-  need(sizeof kEnd);
-  if (std::memcmp(bytes.data() + at, kEnd, sizeof kEnd) != 0 || at + sizeof kEnd != bytes.size())
-    throw InputError(where + ": damaged particle file (no end marker where its sizes put it)");
-
+  const RawFile f = read_raw(path, where);
   ParticleFile out;
-  std::string raw(raw_size, '\0');
-  uLongf unpacked = raw_size;
+  out.header_checked = f.format == kFormat;
+  std::string raw(f.raw_size, '\0');
+  uLongf unpacked = f.raw_size;
   if (uncompress(reinterpret_cast<Bytef*>(raw.data()), &unpacked,
-                 reinterpret_cast<const Bytef*>(bytes.data() + packed_at), packed_size) != Z_OK ||
-      unpacked != raw_size ||
-      crc32(0L, reinterpret_cast<const Bytef*>(raw.data()), raw.size()) != crc)
+                 reinterpret_cast<const Bytef*>(f.bytes.data() + f.packed_at), f.packed_size) != Z_OK ||
+      unpacked != f.raw_size ||
+      (f.format == kFormatArraysOnly && crc32(0L, reinterpret_cast<const Bytef*>(raw.data()), raw.size()) != f.arrays_crc))
     throw InputError(where + ": damaged particle file (its arrays fail their checksum)");
   try {
-    const nlohmann::json header = nlohmann::json::parse(header_text);
+    const nlohmann::json header = nlohmann::json::parse(f.header_text);
     read_scalars(header, out.snapshot);
     out.metadata = header.at("metadata");
     std::size_t pos = 0;
@@ -230,15 +250,20 @@ ParticleFile read_particle_file(const std::filesystem::path& path) {
   return out;
 }
 
-nlohmann::json read_particle_file_metadata(const std::filesystem::path& path) {
+ParticleFileHeader read_particle_file_header(const std::filesystem::path& path) {
   const std::string where = path.string();
-  std::ifstream f;
-  const std::string header_text = open_and_read_header(path, where, f);
+  const RawFile f = read_raw(path, where);
   try {
-    return nlohmann::json::parse(header_text).at("metadata");
+    return {nlohmann::json::parse(f.header_text).at("metadata"), f.format == kFormat};
   } catch (const std::exception& e) {
     throw InputError(where + ": damaged particle file (" + e.what() + ")");
   }
+}
+
+std::string unchecked_header_warning(const std::filesystem::path& path) {
+  return path.string() + ": particle file format " + std::to_string(kFormatArraysOnly) +
+         ": its checksum covers its arrays but not its header (time, geometry, measurement settings), "
+         "so damage there would go unnoticed; write it again with this crevasse to have it checked";
 }
 
 }  // namespace crevasse

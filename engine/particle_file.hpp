@@ -24,15 +24,24 @@ void write_particle_file(const std::filesystem::path& path, const ParticleSnapsh
 struct ParticleFile {
   ParticleSnapshot snapshot;
   nlohmann::json metadata;
+  bool header_checked = true;  // false for a format 1 file: its checksum covers only its arrays
 };
 
 // InputError naming the file when it is missing, not a particle file, of a newer format,
-// truncated or damaged (the arrays carry a CRC-32 and their lengths are checked).
+// truncated or damaged: one CRC-32 covers the whole file, header included, and the sizes and
+// array lengths are checked. A format 1 file (an older crevasse) is read with only its arrays
+// checked; header_checked says so, and unchecked_header_warning is the line to show.
 ParticleFile read_particle_file(const std::filesystem::path& path);
 
-// The metadata alone, read from the header without touching the particles: what a caller that
-// only sorts files needs. InputError as above for a file that is not a particle file of this
-// format; damage in the arrays is found only by read_particle_file.
-nlohmann::json read_particle_file_metadata(const std::filesystem::path& path);
+// The metadata alone, without decompressing the particles: what a caller that only sorts files
+// needs. The whole file's checksum is checked (format 2), so the refusals are those of
+// read_particle_file but for damage inside a format 1 file's arrays.
+struct ParticleFileHeader {
+  nlohmann::json metadata;
+  bool header_checked = true;
+};
+ParticleFileHeader read_particle_file_header(const std::filesystem::path& path);
+
+std::string unchecked_header_warning(const std::filesystem::path& path);
 
 }  // namespace crevasse

@@ -86,9 +86,9 @@ class CaseContext {
   // (Study::measure_interval_s).
   void set_measure_interval(double s) { measure_interval_s_ = s; }
   double measure_interval_s() const { return measure_interval_s_; }
-  // Whether the case also keeps its final particles there (case_NNN_particles.bin).
-  void set_keep_particles(bool keep) { keep_particles_ = keep; }
-  bool keep_particles() const { return keep_particles_; }
+  // Where the case keeps its final particles (case_NNN_particles.bin; empty: nowhere).
+  void set_particles_dir(std::filesystem::path dir) { particles_dir_ = std::move(dir); }
+  const std::filesystem::path& particles_dir() const { return particles_dir_; }
 
  private:
   int threads_;
@@ -101,7 +101,7 @@ class CaseContext {
   std::filesystem::path checkpoint_file_;
   double checkpoint_interval_s_ = 0.0;
   std::filesystem::path views_dir_;
-  bool keep_particles_ = false;
+  std::filesystem::path particles_dir_;
   double measure_interval_s_ = 0.0;
   std::function<void(const std::string&)> warn_;
 };

@@ -54,6 +54,18 @@ class CaseObserver : public RunObserver {
   FieldOverTime over_time_;
 };
 
+// Thrown by the measurement's poll when the case has to stop: for the runner's stop signal
+// (out_of_time empty) or for its time limit.
+struct MeasurementStopped {
+  std::optional<std::string> out_of_time;
+};
+
+// The shorter of the scene's run.wall_time_limit and the case's time limit; 0: none.
+double case_wall_limit_s(const SceneConfig& scene, const CaseContext& ctx) {
+  const double a = scene.wall_time_limit, b = ctx.time_limit_s();
+  return a > 0 && b > 0 ? std::min(a, b) : std::max(a, b);
+}
+
 void check_finite(const ParticleSnapshot& s) {
   for (std::size_t i = 0; i < s.size(); ++i) {
     const bool ok = std::isfinite(s.x[i]) && std::isfinite(s.z[i]) && std::isfinite(s.eps_v_p[i]) &&
@@ -78,13 +90,25 @@ nlohmann::json particle_file_metadata(const SceneConfig& scene, const analysis::
 
 void measure_final_state(const StudyCase& study_case, CaseContext& ctx, const ParticleSnapshot& final_snapshot,
                          CaseOutcome& out) {
+  // The measurement stops for the same signal and clock as the run: the case stays pending, or
+  // fails out of time.
+  const double limit_s = case_wall_limit_s(study_case.scene, ctx);
+  const analysis::MeasurePoll poll = [&ctx, limit_s] {
+    if (ctx.stop_requested()) throw MeasurementStopped{};
+    if (limit_s > 0 && ctx.elapsed_s() > limit_s) {
+      char what[160];
+      std::snprintf(what, sizeof what,
+                    "time limit: %g s (run.wall_time_limit or the case time limit) reached while measuring", limit_s);
+      throw MeasurementStopped{what};
+    }
+  };
   try {
-    out.measurement = analysis::measure_crevasses(final_snapshot, ctx.measurement());
+    out.measurement = analysis::measure_crevasses(final_snapshot, ctx.measurement(), poll);
     // The other spacing rule on the same snapshot, so that both are reported
     // (docs/measurement.md, "The source study's rule"): result_json.other_spacing_rule.
     analysis::MeasureSettings other = ctx.measurement();
     other.spacing_rule = other.spacing_rule == "merge" ? "drop" : "merge";
-    const analysis::CrevasseMeasurement alt = analysis::measure_crevasses(final_snapshot, other);
+    const analysis::CrevasseMeasurement alt = analysis::measure_crevasses(final_snapshot, other, poll);
     nlohmann::json depths = nlohmann::json::array();
     for (const auto& c : alt.crevasses) depths.push_back(c.depth_m);
     out.result_extra["other_spacing_rule"] = {
@@ -97,24 +121,33 @@ void measure_final_state(const StudyCase& study_case, CaseContext& ctx, const Pa
         {"depth_median_m", alt.depth_m ? nlohmann::json(alt.depth_m->median) : nlohmann::json()}};
   } catch (const std::invalid_argument& e) {
     throw SimulationError(std::string("measurement of the final snapshot failed: ") + e.what());
+  } catch (const MeasurementStopped& stopped) {
+    out.cancelled = true;
+    out.out_of_time = stopped.out_of_time;
+    out.measurement.reset();
+    return;
   }
-  if (!ctx.views_dir().empty()) {
-    char stem[32];
-    std::snprintf(stem, sizeof stem, "case_%03zu_", study_case.index);
-    // The side files are a view of the result, not the result: one that cannot be written (a
-    // full disk) is reported, and the case's measurement is stored all the same.
+  char stem[32];
+  std::snprintf(stem, sizeof stem, "case_%03zu_", study_case.index);
+  // The side files are a view of the result, not the result: one that cannot be written (a
+  // full disk) is reported, and the case's measurement is stored all the same.
+  const auto side_files = [&](const std::filesystem::path& dir, const auto& write) {
+    if (dir.empty()) return;
     try {
-      std::filesystem::create_directories(ctx.views_dir());
-      write_case_views(study_case.scene, final_snapshot, *out.measurement, ctx.views_dir(), stem);
-      if (ctx.keep_particles())
-        write_particle_file(ctx.views_dir() / (std::string(stem) + "particles.bin"), final_snapshot,
-                            particle_file_metadata(study_case.scene, ctx.measurement(), study_case.case_id,
-                                                   study_case.label));
+      std::filesystem::create_directories(dir);
+      write(dir);
     } catch (const std::exception& e) {
-      ctx.warn(std::string("its side files in ") + ctx.views_dir().string() + " were not all written (" +
-               e.what() + "); its result is stored");
+      ctx.warn(std::string("its side files in ") + dir.string() + " were not all written (" + e.what() +
+               "); its result is stored");
     }
-  }
+  };
+  side_files(ctx.views_dir(), [&](const std::filesystem::path& dir) {
+    write_case_views(study_case.scene, final_snapshot, *out.measurement, dir, stem);
+  });
+  side_files(ctx.particles_dir(), [&](const std::filesystem::path& dir) {
+    write_particle_file(dir / (std::string(stem) + "particles.bin"), final_snapshot,
+                        particle_file_metadata(study_case.scene, ctx.measurement(), study_case.case_id, study_case.label));
+  });
 }
 
 CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx) {
@@ -125,9 +158,7 @@ CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx) {
   // the checkpoint when it fires and leaves the limit out of the checkpoint's scene, so a case
   // that ran out of time continues from where it stopped once the limit is raised (the runner
   // keeps the checkpoint).
-  if (ctx.time_limit_s() > 0)
-    scene.wall_time_limit =
-        scene.wall_time_limit > 0 ? std::min(scene.wall_time_limit, ctx.time_limit_s()) : ctx.time_limit_s();
+  scene.wall_time_limit = case_wall_limit_s(scene, ctx);
   CaseObserver observer(ctx);
   RunSummary r;
   try {

@@ -13,7 +13,9 @@ CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx);
 
 // Measures a case's final state into `out` with ctx.measurement(), and under the other spacing
 // rule too (result_extra.other_spacing_rule), and writes its side files when ctx asks for them.
-// Throws SimulationError when the measurement fails.
+// Throws SimulationError when the measurement fails. The stop signal and the case's time limit
+// (the shorter of it and run.wall_time_limit, counted from the case's start) end it as they end
+// a run: `out` comes back cancelled, with out_of_time set for the limit.
 void measure_final_state(const StudyCase& study_case, CaseContext& ctx, const ParticleSnapshot& final_snapshot,
                          CaseOutcome& out);
 

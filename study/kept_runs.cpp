@@ -1,6 +1,8 @@
 #include "study/kept_runs.hpp"
 
 #include <algorithm>
+#include <cctype>
+#include <set>
 
 #include "engine/error.hpp"
 #include "engine/particle_file.hpp"
@@ -9,6 +11,24 @@
 #include "study/store.hpp"
 
 namespace crevasse {
+namespace {
+
+const std::string kTail = "_particles.bin";
+
+bool ends_with_tail(const std::string& name) {
+  return name.size() > kTail.size() && name.compare(name.size() - kTail.size(), kTail.size(), kTail) == 0;
+}
+
+}  // namespace
+
+std::optional<std::size_t> kept_particles_case_index(const std::filesystem::path& file) {
+  const std::string name = file.filename().string();
+  const std::string head = "case_";
+  if (!ends_with_tail(name) || name.compare(0, head.size(), head) != 0) return std::nullopt;
+  const std::string digits = name.substr(head.size(), name.size() - head.size() - kTail.size());
+  if (digits.empty() || digits.size() > 9 || !std::all_of(digits.begin(), digits.end(), [](unsigned char c) { return std::isdigit(c) != 0; })) return std::nullopt;
+  return static_cast<std::size_t>(std::stoul(digits));
+}
 
 KeptRuns::KeptRuns(std::filesystem::path db, const std::filesystem::path& particles_dir)
     : db_(std::move(db)), dir_(particles_dir) {
@@ -17,25 +37,27 @@ KeptRuns::KeptRuns(std::filesystem::path db, const std::filesystem::path& partic
     throw InputError("--remeasure: " + db_.string() + " is not a study database (no such file)");
   if (!std::filesystem::is_directory(dir_, ec))
     throw InputError("--particles-from: " + dir_.string() + " is not a folder");
-  std::vector<std::filesystem::path> paths;
-  for (const auto& e : std::filesystem::directory_iterator(dir_, ec)) {
-    const std::string name = e.path().filename().string();
-    const std::string tail = "_particles.bin";
-    if (name.size() > tail.size() && name.compare(name.size() - tail.size(), tail.size(), tail) == 0)
-      paths.push_back(e.path());
-  }
-  std::sort(paths.begin(), paths.end());
-  for (const auto& p : paths) {
-    // The particles are read by the case that uses them.
-    const nlohmann::json meta = read_particle_file_metadata(p);
-    if (!meta.contains("case_id") || !meta.contains("measurement") || !meta.contains("engine_version"))
-      continue;  // not written by a study
-    files_.push_back({p, meta.at("case_id").get<std::string>(), meta.at("engine_version").get<std::string>(),
-                      meta.at("measurement")});
-  }
-  if (files_.empty())
+  for (const auto& e : std::filesystem::directory_iterator(dir_, ec))
+    if (ends_with_tail(e.path().filename().string())) paths_.push_back(e.path());
+  std::sort(paths_.begin(), paths_.end());
+  if (paths_.empty())
     throw InputError("--particles-from: " + dir_.string() +
                      " holds no case_NNN_particles.bin written by crevasse study --keep-particles");
+  for (const auto& p : paths_) {
+    // The particles are read by the case that uses them; the header is checked here.
+    try {
+      const ParticleFileHeader h = read_particle_file_header(p);
+      const nlohmann::json& meta = h.metadata;
+      if (!meta.is_object() || !meta.contains("case_id") || !meta.contains("measurement") ||
+          !meta.contains("engine_version"))
+        unusable_.push_back({p, "not written by crevasse study --keep-particles"});
+      else
+        files_.push_back({p, meta.at("case_id").get<std::string>(), meta.at("engine_version").get<std::string>(),
+                          meta.at("measurement"), h.header_checked});
+    } catch (const std::exception& e) {
+      unusable_.push_back({p, e.what()});
+    }
+  }
   // Fails here, with the option's name, rather than in every case.
   try {
     Store::open_reader(db_);
@@ -52,11 +74,44 @@ const KeptRuns::Kept* KeptRuns::find(const StudyCase& study_case) const {
   return nullptr;
 }
 
+const KeptRuns::Unusable* KeptRuns::damaged_file_of(const StudyCase& study_case) const {
+  for (const Unusable& u : unusable_)
+    if (kept_particles_case_index(u.path) == study_case.index) return &u;
+  return nullptr;
+}
+
+std::vector<std::string> KeptRuns::warnings(const Study& study) const {
+  std::vector<std::string> out;
+  std::set<std::filesystem::path> used;
+  std::set<std::size_t> indices;
+  for (const StudyCase& c : study.cases) {
+    indices.insert(c.index);
+    if (const Kept* k = find(c)) used.insert(k->path);
+  }
+  for (const Kept& k : files_) {
+    if (!used.count(k.path))
+      out.push_back(k.path.string() + ": its particles belong to no case of this study (another scene, or engine " +
+                    k.engine_version + "); ignored");
+    else if (!k.header_checked)
+      out.push_back(unchecked_header_warning(k.path));
+  }
+  for (const Unusable& u : unusable_) {
+    const auto index = kept_particles_case_index(u.path);
+    if (!index || !indices.count(*index))
+      out.push_back(u.reason.rfind(u.path.string(), 0) == 0 ? u.reason + "; it names no case of this study, ignored"
+                                                            : u.path.string() + ": " + u.reason + "; ignored");
+  }
+  return out;
+}
+
 CaseOutcome KeptRuns::operator()(const StudyCase& study_case, CaseContext& ctx) const {
   const Kept* kept = find(study_case);
-  if (!kept)
+  if (!kept) {
+    if (const Unusable* u = damaged_file_of(study_case))
+      throw SimulationError("its kept particles cannot be used: " + u->reason);
     throw SimulationError("no particles kept in " + dir_.string() + " for this case's scene and engine version " +
                           CREVASSE_ENGINE_VERSION + "; run it without --remeasure (--retry-failed)");
+  }
   nlohmann::json result, run;
   {
     Store store = Store::open_reader(db_);
@@ -68,7 +123,12 @@ CaseOutcome KeptRuns::operator()(const StudyCase& study_case, CaseContext& ctx) 
     result = nlohmann::json::parse(s.text(1));
     run = nlohmann::json::parse(s.text(2));
   }
-  ParticleFile file = read_particle_file(kept->path);
+  ParticleFile file;
+  try {
+    file = read_particle_file(kept->path);
+  } catch (const InputError& e) {
+    throw SimulationError(std::string("its kept particles cannot be used: ") + e.what());
+  }
   CaseOutcome out;
   out.stop_reason = result.at("stop_reason").get<std::string>();
   out.steps = result.at("steps").get<std::int64_t>();

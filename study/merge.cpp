@@ -214,6 +214,7 @@ MergeReport merge_databases(const fs::path& out, const std::vector<fs::path>& in
     for (std::size_t at = message.find(temp); at != std::string::npos; at = message.find(temp, at))
       message.replace(at, temp.size(), out.string());
     if (dynamic_cast<const InputError*>(&e)) throw InputError(message);
+    if (dynamic_cast<const ResourceError*>(&e)) throw ResourceError(message);
     throw std::runtime_error(message);
   }
   return report;

@@ -265,7 +265,7 @@ class StudyRun {
     top_up_memory_reserve();  // in case an earlier failure could not take all of it back
     CaseContext ctx(threads, time_limit_, study_.measurement, stop(), progress_of_[slot]);
     if (!opt_.views_dir.empty()) ctx.set_views_dir(opt_.views_dir);
-    ctx.set_keep_particles(opt_.keep_particles);
+    if (!opt_.particles_dir.empty()) ctx.set_particles_dir(opt_.particles_dir);
     ctx.set_measure_interval(study_.measure_interval_s);
     ctx.set_warn([this, slot](const std::string& m) { queue_.push(Event{Event::Kind::warning, slot, {}, {}, m}); });
     std::filesystem::path checkpoint;

@@ -69,8 +69,8 @@ struct RunnerOptions {
   // Warnings that do not fail a case (a checkpoint that could not be written or used), with
   // the case's label; called on the calling thread. Empty: not shown.
   std::function<void(const std::string&)> warn;
-  std::filesystem::path views_dir;  // non-empty: each case writes its side views there
-  bool keep_particles = false;      // and its final particles (needs views_dir)
+  std::filesystem::path views_dir;      // non-empty: each case writes its side views there
+  std::filesystem::path particles_dir;  // non-empty: and keeps its final particles there
   // Set from outside (a signal handler) to end the session early: no new case starts, and the
   // running ones save a checkpoint and stay pending for the next session (report.interrupted).
   std::atomic<bool>* interrupt = nullptr;

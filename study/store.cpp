@@ -133,9 +133,29 @@ CREATE TABLE IF NOT EXISTS summaries (
 );
 )SQL";
 
-[[noreturn]] void sql_fail(sqlite3* db, const std::string& what) {
-  throw std::runtime_error("database: " + what + ": " +
-                           (db ? sqlite3_errmsg(db) : "out of memory"));
+// A failed write (full disk, file-size limit, lost write permission) surfaces as FULL or IOERR,
+// a file another process holds past the busy timeout as BUSY or LOCKED: ResourceError with the
+// path and what to do. The transaction is rolled back, so what was stored stays whole and the
+// same command continues. Anything else is an error of this program.
+[[noreturn]] void sql_fail(sqlite3* db, int rc, const std::string& what) {
+  const std::string path = db && sqlite3_db_filename(db, "main") ? sqlite3_db_filename(db, "main") : "";
+  const std::string msg = db ? sqlite3_errmsg(db) : "out of memory";
+  const std::string head = "database " + (path.empty() ? std::string("(in memory)") : path) + ": " + msg +
+                           " (while running '" + what + "')";
+  switch (rc & 0xff) {
+    case SQLITE_FULL:
+    case SQLITE_IOERR:
+    case SQLITE_READONLY:
+    case SQLITE_CANTOPEN:
+      throw ResourceError(head + "; the disk may be full or the file not writable: free space or fix the path, then "
+                                 "run the same command again to resume (what is stored is kept)");
+    case SQLITE_BUSY:
+    case SQLITE_LOCKED:
+      throw ResourceError(head + "; another process holds the database: wait for it to finish, then run the "
+                                 "same command again");
+    default:
+      throw std::runtime_error(head);
+  }
 }
 
 }  // namespace
@@ -143,33 +163,33 @@ CREATE TABLE IF NOT EXISTS summaries (
 // ---------------------------------------------------------------------------------------------
 Statement::Statement(sqlite3* db, const std::string& sql) : db_(db), sql_(sql) {
   if (sqlite3_prepare_v2(db_, sql.c_str(), -1, &stmt_, nullptr) != SQLITE_OK)
-    sql_fail(db_, "cannot prepare '" + sql.substr(0, 60) + "'");
+    sql_fail(db_, sqlite3_errcode(db_), sql.substr(0, 60));
 }
 Statement::~Statement() { sqlite3_finalize(stmt_); }
 
 Statement& Statement::bind(int i, const std::string& v) {
   if (sqlite3_bind_text(stmt_, i, v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT) !=
       SQLITE_OK)
-    sql_fail(db_, "bind");
+    sql_fail(db_, sqlite3_errcode(db_), "bind");
   return *this;
 }
 Statement& Statement::bind(int i, double v) {
-  if (sqlite3_bind_double(stmt_, i, v) != SQLITE_OK) sql_fail(db_, "bind");
+  if (sqlite3_bind_double(stmt_, i, v) != SQLITE_OK) sql_fail(db_, sqlite3_errcode(db_), "bind");
   return *this;
 }
 Statement& Statement::bind(int i, std::int64_t v) {
-  if (sqlite3_bind_int64(stmt_, i, v) != SQLITE_OK) sql_fail(db_, "bind");
+  if (sqlite3_bind_int64(stmt_, i, v) != SQLITE_OK) sql_fail(db_, sqlite3_errcode(db_), "bind");
   return *this;
 }
 Statement& Statement::bind(int i, std::nullopt_t) {
-  if (sqlite3_bind_null(stmt_, i) != SQLITE_OK) sql_fail(db_, "bind");
+  if (sqlite3_bind_null(stmt_, i) != SQLITE_OK) sql_fail(db_, sqlite3_errcode(db_), "bind");
   return *this;
 }
 bool Statement::step() {
   const int rc = sqlite3_step(stmt_);
   if (rc == SQLITE_ROW) return true;
   if (rc == SQLITE_DONE) return false;
-  sql_fail(db_, "'" + sql_.substr(0, 60) + "' failed");
+  sql_fail(db_, rc, sql_.substr(0, 60));
 }
 void Statement::run() {
   while (step()) {
@@ -232,19 +252,8 @@ Store::~Store() {
 void Store::exec(const std::string& sql) {
   char* err = nullptr;
   if (const int rc = sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &err); rc != SQLITE_OK) {
-    const std::string msg = err ? err : sqlite3_errmsg(db_);
-    sqlite3_free(err);
-    // A failed write (full disk, file-size limit, lost write permission) surfaces as FULL or
-    // IOERR; the transaction is rolled back, so the finished cases stay whole and a resume
-    // re-runs only the case that was being stored.
-    const int primary = rc & 0xff;
-    const std::string hint =
-        primary == SQLITE_FULL || primary == SQLITE_IOERR || primary == SQLITE_READONLY
-            ? "; the disk may be full or the file not writable: free space or fix the path, then "
-              "run the same command again to resume (cases already stored are kept)"
-            : "";
-    throw std::runtime_error("database " + path_.string() + ": " + msg + " (while running '" +
-                             sql.substr(0, 40) + "')" + hint);
+    sqlite3_free(err);  // sqlite3_errmsg says the same
+    sql_fail(db_, rc, sql.substr(0, 40));
   }
 }
 
@@ -319,10 +328,10 @@ Store Store::open_writer(const fs::path& path, double wait_s, const std::string&
   if (!locked) {
     undo();
     ::close(fd);
-    throw InputError(where +
-                     ": another crevasse process is writing to this database (the file is "
-                     "locked); wait for it to end" +
-                     (option == "--db" ? std::string(" or use another --db") : std::string()));
+    throw ResourceError(where +
+                        ": another crevasse process is writing to this database (the file is "
+                        "locked); wait for it to end and run the same command again" +
+                        (option == "--db" ? std::string(", or use another --db") : std::string()));
   }
   sqlite3* db = nullptr;
   if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr) !=
@@ -370,7 +379,8 @@ Store Store::open_writer(const fs::path& path, double wait_s, const std::string&
       store.exec("PRAGMA user_version = " + std::to_string(kStoreSchemaVersion));
     });
   } catch (const std::runtime_error& e) {
-    const std::string message = dynamic_cast<const InputError*>(&e)
+    const bool resource = dynamic_cast<const ResourceError*>(&e) != nullptr;
+    const std::string message = dynamic_cast<const InputError*>(&e) || resource
                                     ? std::string(e.what())
                                     : where + ": cannot write the database (" + e.what() + ")";
     if (created) {  // a database this call began (full disk, no file descriptors): none at all
@@ -379,6 +389,7 @@ Store Store::open_writer(const fs::path& path, double wait_s, const std::string&
       for (const char* suffix : {"-wal", "-shm", "-journal"}) fs::remove(path.string() + suffix, ec);
       undo();  // still under the lock, which the store releases after
     }
+    if (resource) throw ResourceError(message);
     throw InputError(message);
   }
   return store;

@@ -311,7 +311,7 @@ analysis::MeasureSettings measure_settings_from_json(const json& j) {
            "value " + std::to_string(s.surface_smoothing_bins) + " must be odd");
   }
   num("surface_bridge_half_width_over_h", s.surface_bridge_half_width_over_h,
-      {0.0, 10.0, false, false});
+      {0.0, 1.0, false, false});
   num("fragmented_fraction", s.fragmented_fraction, {0.0, 1.0, true, false});
   num("y_band_width_over_dx", s.y_band_width_over_dx, {0.0, 1e4, true, false});
   opt("y_band_center_m", s.y_band_center_m, {-1e9, 1e9, false, false});
@@ -590,6 +590,13 @@ StudyCase make_case(const Study& st, std::size_t index, const SceneConfig& defau
          "replicas differ only by /numerics/seed, which has no effect while /numerics/jitter is "
          "0; "
          "set /numerics/jitter in (0, 0.5]");
+  // The measurement's lengths against this case's own scales, before anything is simulated.
+  try {
+    analysis::check_measure_scales(st.measurement, {c.scene.dx, c.scene.ice_thickness,
+                                                    c.scene.dx / c.scene.particles_per_cell_axis});
+  } catch (const std::invalid_argument& e) {
+    throw InputError("measurement." + std::string(e.what()) + ", in " + where);
+  }
   c.scene_json = scene_to_json(c.scene);
   c.groups = groups_of(c.scene);
   c.case_id = case_hash(c.scene, st.measurement_json);

@@ -3,6 +3,7 @@
 // file of this format is refused with an InputError naming the file, never read as data.
 #include <gtest/gtest.h>
 #include <unistd.h>
+#include <zlib.h>
 
 #include <cstdint>
 #include <cstring>
@@ -79,7 +80,10 @@ void round_trip(int dim) {
   const nlohmann::json meta = {{"case_id", "abc"}, {"density_kg_m3", 917.0}, {"measurement", {{"frame", "passed"}}}};
   write_particle_file(path, s, meta);
   const ParticleFile f = read_particle_file(path);
-  EXPECT_EQ(read_particle_file_metadata(path), meta);
+  const ParticleFileHeader header = read_particle_file_header(path);
+  EXPECT_EQ(header.metadata, meta);
+  EXPECT_TRUE(header.header_checked);
+  EXPECT_TRUE(f.header_checked);
   std::filesystem::remove(path);
   const ParticleSnapshot& r = f.snapshot;
   EXPECT_EQ(f.metadata, meta);
@@ -127,6 +131,84 @@ void expect_refused(const std::filesystem::path& p, const std::string& bytes, co
   }
 }
 
+// One checksum covers the whole file: a bit flipped anywhere in the header (a scalar such as the
+// gate's position or the passed length, a metadata field, the array table, the sizes) is refused by
+// both readers, as a flip in the arrays is.
+TEST(ParticleFile, AFlippedBitInTheHeaderIsRefused) {
+  const auto path = temp_file("header");
+  write_particle_file(path, make_snapshot(2, 200), {{"case_id", "abc"}, {"measurement", {{"frame", "passed"}}}});
+  const std::string whole = slurp(path);
+  std::uint64_t header_size = 0;
+  std::memcpy(&header_size, whole.data() + 12, sizeof header_size);
+  const std::size_t sizes_end = 20 + header_size + 16;
+  ASSERT_LT(sizes_end, whole.size());
+  int flips = 0;
+  for (const std::string field : {"\"gate_x_m\":", "\"gate_passed_length_m\":", "\"softening_zeta\":",
+                                  "\"case_id\":", "\"frame\":", "\"count\":"}) {
+    const std::size_t at = whole.find(field, 20);
+    ASSERT_LT(at, 20 + header_size) << field;
+    std::string bad = whole;
+    bad[at + field.size() + 1] ^= 0x01;  // a digit or letter of its value: still valid JSON mostly
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << bad;
+    EXPECT_THROW(read_particle_file(path), InputError) << field;
+    EXPECT_THROW(read_particle_file_header(path), InputError) << field;
+    ++flips;
+  }
+  for (std::size_t k = 8; k < sizes_end; k += 5) {  // every part before the arrays
+    std::string bad = whole;
+    bad[k] ^= 0x04;
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << bad;
+    EXPECT_THROW(read_particle_file(path), InputError) << "byte " << k;
+    EXPECT_THROW(read_particle_file_header(path), InputError) << "byte " << k;
+    ++flips;
+  }
+  EXPECT_GT(flips, 50);
+  std::filesystem::remove(path);
+}
+
+// A file in the layout of format 1 (an older crevasse): the CRC-32 of the uncompressed arrays
+// before them, none over the header.
+std::string format_1_file(const std::string& format_2) {
+  std::uint64_t header_size = 0, raw_size = 0, packed_size = 0;
+  std::memcpy(&header_size, format_2.data() + 12, 8);
+  const std::size_t sizes = 20 + header_size;
+  std::memcpy(&raw_size, format_2.data() + sizes, 8);
+  std::memcpy(&packed_size, format_2.data() + sizes + 8, 8);
+  const std::string packed = format_2.substr(sizes + 16, packed_size);
+  std::string raw(raw_size, '\0');
+  uLongf n = raw_size;
+  EXPECT_EQ(uncompress(reinterpret_cast<Bytef*>(raw.data()), &n, reinterpret_cast<const Bytef*>(packed.data()),
+                       packed.size()),
+            Z_OK);
+  const auto crc = static_cast<std::uint32_t>(crc32(0L, reinterpret_cast<const Bytef*>(raw.data()), raw.size()));
+  std::string out = format_2.substr(0, sizes + 16);
+  out[8] = 1;
+  out.append(reinterpret_cast<const char*>(&crc), sizeof crc);
+  out += packed;
+  out += format_2.substr(format_2.size() - 8);
+  return out;
+}
+
+// Format 1 files are still read, their arrays checked, and the readers say that the header is
+// not; damage in a format 1 file's arrays is still refused.
+TEST(ParticleFile, Format1IsReadWithItsHeaderMarkedUnchecked) {
+  const auto path = temp_file("format1");
+  const ParticleSnapshot s = make_snapshot(2, 300);
+  write_particle_file(path, s, {{"case_id", "old"}});
+  const std::string old = format_1_file(slurp(path));
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << old;
+  const ParticleFile f = read_particle_file(path);
+  EXPECT_FALSE(f.header_checked);
+  EXPECT_EQ(f.snapshot.x, s.x);
+  EXPECT_EQ(f.metadata.at("case_id"), "old");
+  EXPECT_FALSE(read_particle_file_header(path).header_checked);
+  EXPECT_NE(unchecked_header_warning(path).find("header"), std::string::npos);
+  std::string bad = old;
+  bad[old.size() - 30] ^= 0x10;
+  expect_refused(path, bad, "format 1 file with a flipped array byte");
+  std::filesystem::remove(path);
+}
+
 TEST(ParticleFile, TruncatedDamagedAndForeignFilesAreRefused) {
   const auto path = temp_file("bad");
   write_particle_file(path, make_snapshot(2, 200));
@@ -134,18 +216,10 @@ TEST(ParticleFile, TruncatedDamagedAndForeignFilesAreRefused) {
   ASSERT_GT(whole.size(), 100u);
   // Every cut, in steps small enough to land in each part (magic, header, sizes, payload, end).
   for (std::size_t cut = 0; cut < whole.size(); cut += 7) expect_refused(path, whole.substr(0, cut), "cut file");
-  // The header alone (magic, format, its size, its JSON): refused when cut inside it, read
-  // whole when the cut falls in the arrays, which only read_particle_file checks.
-  std::uint64_t header_size = 0;
-  std::memcpy(&header_size, whole.data() + 12, sizeof header_size);
-  const std::size_t header_end = 20 + header_size;
-  ASSERT_LT(header_end, whole.size());
-  for (std::size_t cut = 0; cut < whole.size(); cut += 7) {
+  // The header reader checks the whole file too: no cut passes it.
+  for (std::size_t cut = 0; cut < whole.size(); cut += 61) {
     std::ofstream(path, std::ios::binary | std::ios::trunc) << whole.substr(0, cut);
-    if (cut < header_end)
-      EXPECT_THROW(read_particle_file_metadata(path), InputError) << "cut at " << cut;
-    else
-      EXPECT_NO_THROW(read_particle_file_metadata(path)) << "cut at " << cut;
+    EXPECT_THROW(read_particle_file_header(path), InputError) << "cut at " << cut;
   }
   expect_refused(path, whole + "x", "file with bytes after its end");
   // A byte flipped in the compressed arrays: zlib or the CRC-32 notices.
@@ -156,7 +230,7 @@ TEST(ParticleFile, TruncatedDamagedAndForeignFilesAreRefused) {
   }
   expect_refused(path, "<?xml version=\"1.0\"?>\n<VTKFile/>\n", "foreign file");
   std::string newer = whole;
-  newer[8] = 2;  // format number
+  newer[8] = 3;  // format number
   expect_refused(path, newer, "newer format");
   std::filesystem::remove(path);
   EXPECT_THROW(read_particle_file(path), InputError);

@@ -166,6 +166,19 @@ inline CliResult run_cli(const std::filesystem::path& dir, const std::string& ar
   return r;
 }
 
+// The same under a file-size limit of `kib` KiB, as a full disk would stop its writes: bash
+// ignores SIGXFSZ, so that writes past `ulimit -f` fail with EFBIG instead. Standard output is
+// dropped.
+inline CliResult run_cli_on_full_disk(const std::filesystem::path& dir, const std::string& args, int kib) {
+  const std::string cmd = "cd '" + dir.string() + "' && bash -c \"trap '' XFSZ; ulimit -f " + std::to_string(kib) +
+                          "; exec '" CREVASSE_BINARY "' " + args + "\" > /dev/null 2> cli_err.txt";
+  const int status = std::system(cmd.c_str());
+  CliResult r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.err = read_file(dir / "cli_err.txt");
+  return r;
+}
+
 // Starts the crevasse binary (CREVASSE_BINARY) with `args`, its stderr to `stderr_path`;
 // returns the child's pid, or -1.
 inline pid_t spawn_crevasse(const std::vector<std::string>& args, const std::string& stderr_path) {

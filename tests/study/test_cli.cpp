@@ -320,14 +320,9 @@ TEST(Cli, FullDiskFailsCleanlyAndResumes) {
   const Result ref = run_cli(dir.path(), "study s.json --db ref.db --jobs 1 --quiet");
   ASSERT_EQ(ref.code, 0) << ref.err;
 
-  // bash: ignore SIGXFSZ so that writes past `ulimit -f` (KiB) fail with EFBIG instead.
-  const std::string cmd = "cd '" + dir.path().string() +
-                          "' && bash -c \"trap '' XFSZ; ulimit -f 200; exec '" CREVASSE_BINARY
-                          "' study s.json --db k.db --jobs 1 --quiet\" 2> full_err.txt";
-  const int status = std::system(cmd.c_str());
-  ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 1);
-  const std::string err = read_file(dir / "full_err.txt");
+  const Result full = test::run_cli_on_full_disk(dir.path(), "study s.json --db k.db --jobs 1 --quiet", 200);
+  EXPECT_EQ(full.code, 1);
+  const std::string& err = full.err;
   EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
   EXPECT_NE(err.find("the disk may be full"), std::string::npos) << err;
   EXPECT_EQ(test::pragma_integrity(dir / "k.db"), "ok");
@@ -461,21 +456,18 @@ TEST(Cli, MeasureAgainReproducesTheRunsMeasurementAndTakesOtherSettings) {
   EXPECT_NE(missing.err.find("nothing.bin"), std::string::npos) << missing.err;
 }
 
-// `crevasse study --keep-particles` keeps each case's final particles beside its side views;
-// measured again they give the case's stored summary (crevasse count, window, particle, damage
-// and cluster counts), and the file names the case.
+// `crevasse study --keep-particles` keeps each case's final particles in DB.particles/ beside
+// the database (a folder git ignores), whether or not side views are drawn; measured again they
+// give the case's stored summary (crevasse count, window, particle, damage and cluster counts),
+// and the file names the case.
 TEST(Cli, StudyKeepsParticlesThatMeasureAsStored) {
   test::ScratchDir dir("cli");
   nlohmann::json study = test::tiny_study(2, 200, "keep");
   study["base_scene"]["run"] = {{"end_time", 30.0}};  // long enough for some ice to break
   test::write_text(dir / "s.json", study.dump(2));
-  const Result no_views = run_cli(dir.path(), "study s.json --keep-particles");
-  EXPECT_EQ(no_views.code, 2);
-  EXPECT_NE(no_views.err.find("--views"), std::string::npos) << no_views.err;
-  EXPECT_FALSE(std::filesystem::exists(dir / "results"));
-
-  const Result run = run_cli(dir.path(), "study s.json --views v --keep-particles --quiet");
+  const Result run = run_cli(dir.path(), "study s.json --keep-particles --quiet");
   ASSERT_EQ(run.code, 0) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "v"));
   const auto rows = test::dump_rows(dir / "results/keep.db",
                                     "SELECT c.case_id, s.crevasse_count, s.window_min_x_m, s.window_max_x_m, "
                                     "s.particle_count, s.window_particle_count, s.damaged_particle_count, "
@@ -484,7 +476,7 @@ TEST(Cli, StudyKeepsParticlesThatMeasureAsStored) {
   std::int64_t damaged = 0;
   for (int k = 0; k < 2; ++k) {
     char file[64];
-    std::snprintf(file, sizeof file, "v/case_%03d_particles.bin", k);
+    std::snprintf(file, sizeof file, "results/keep.db.particles/case_%03d_particles.bin", k);
     const std::string out = "m" + std::to_string(k);
     const Result m = run_cli(dir.path(), std::string("measure ") + file + " --out " + out);
     ASSERT_EQ(m.code, 0) << m.err;
@@ -519,7 +511,8 @@ TEST(Cli, RemeasureFromKeptParticlesStoresWhatAFullRunStores) {
   kept["base_scene"]["run"] = {{"end_time", 30.0}};  // long enough for some ice to break
   kept["measurement"] = {{"link_distance_over_spacing", 1.5}};
   test::write_text(dir / "kept.json", kept.dump(2));
-  ASSERT_EQ(run_cli(dir.path(), "study kept.json --db kept.db --views v --keep-particles --quiet").code, 0);
+  // The particles in a folder of the user's choice, as older studies kept them beside their views.
+  ASSERT_EQ(run_cli(dir.path(), "study kept.json --db kept.db --views v --particles-dir v --quiet").code, 0);
 
   nlohmann::json other = kept;
   other["name"] = "other";

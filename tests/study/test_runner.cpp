@@ -283,7 +283,7 @@ TEST(Runner, SideFilesThatCannotBeWrittenLeaveTheResultStored) {
   o.jobs = 1;
   o.threads_per_case = 1;
   o.views_dir = dir / "a_file" / "views";
-  o.keep_particles = true;
+  o.particles_dir = dir / "a_file" / "particles";
   std::mutex m;
   std::vector<std::string> warnings;
   o.warn = [&](const std::string& w) {
@@ -293,7 +293,7 @@ TEST(Runner, SideFilesThatCannotBeWrittenLeaveTheResultStored) {
   const RunnerReport r = run_study(study, o);
   EXPECT_EQ(r.done, 2u) << r.first_failure;
   EXPECT_EQ(r.failed, 0u);
-  ASSERT_EQ(warnings.size(), 2u);
+  ASSERT_EQ(warnings.size(), 4u);  // the side views and the particles of each case
   for (const auto& w : warnings) EXPECT_NE(w.find("its result is stored"), std::string::npos) << w;
   EXPECT_EQ(test::dump_rows(dir / "s.db", "SELECT count(*) FROM summaries")[0], "2");
 }

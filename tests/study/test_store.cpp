@@ -37,7 +37,7 @@ TEST(Store, OnlyOneWriterAtATime) {
   try {
     Store second = Store::open_writer(dir / "s.db");
     FAIL() << "a second writer was allowed";
-  } catch (const InputError& e) {
+  } catch (const ResourceError& e) {
     EXPECT_NE(std::string(e.what()).find("another crevasse process is writing"), std::string::npos)
         << e.what();
   }
