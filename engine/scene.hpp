@@ -188,6 +188,8 @@ struct SceneConfig : ScenePhysics, SceneNumerics, SceneRun, SceneOutput {
   double drive_velocity(double t) const;  // piston speed at time t [m/s]
   double drive_position(double t) const;  // piston face x at time t (0 at t = 0) [m]
   double implied_fracture_energy() const;  // G = c·dx/ζ [J/m²] (band width h = dx)
+  // Particles seeded at the start: the ice box, or the slab, over the particle spacing.
+  double expected_particles() const;
   // Equivalent plastic strain rate per q^n in simulated time: (2/√3)·A·(q/√3)^n, Glen's law in
   // von Mises terms, sped up as the drive is (real time when there is no drive); 0 without creep.
   double creep_rate() const;
