@@ -44,7 +44,7 @@ enum class DriveStart { ramp, moving };
 // What drives the glacier at its back. piston: the back layer of the slab is pushed at V_x, so
 // the slab behind the step is consumed and the push grows with its length. inflow: the grid
 // nodes at the back of the domain move at V_x and ice enters there, a copy of the ice just
-// inside (Simulation::inflow), so the upstream ice is only as long as upstream_length.
+// inside (engine/inflow.hpp), so the upstream ice is only as long as upstream_length.
 enum class DriveBoundary { piston, inflow };
 const char* kind_name(Body k);
 const char* kind_name(BedShape k);
