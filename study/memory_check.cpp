@@ -59,8 +59,8 @@ void keep_smaller(std::optional<double>& a, double b) {
 
 // The tightest limit − usage from `mount` / `path` up to `mount` (a container sees its own
 // cgroup at the mount itself: then only that level is read).
-void cgroup_headroom(const fs::path& mount, const std::string& path, const char* limit_file, const char* usage_file,
-                     std::optional<double>& out) {
+void cgroup_headroom(const fs::path& mount, const std::string& path, const char* limit_file,
+                     const char* usage_file, std::optional<double>& out) {
   if (!fs::is_directory(mount)) return;
   std::vector<fs::path> levels = {mount};
   fs::path dir = mount;
@@ -114,13 +114,15 @@ MemoryHeadroom read_memory_headroom(const fs::path& proc, const fs::path& cgroup
     if (line.compare(0, c1, "0") == 0 && controllers == ",,")
       cgroup_headroom(cgroup_root, path, "memory.max", "memory.current", h.cgroup_bytes);
     else if (controllers.find(",memory,") != std::string::npos)
-      cgroup_headroom(cgroup_root / "memory", path, "memory.limit_in_bytes", "memory.usage_in_bytes", h.cgroup_bytes);
+      cgroup_headroom(cgroup_root / "memory", path, "memory.limit_in_bytes",
+                      "memory.usage_in_bytes", h.cgroup_bytes);
   }
   return h;
 }
 
 double case_memory_bytes(const SceneConfig& scene) {
-  return kBytesPerCase + (scene.dim == 3 ? kBytesPerParticle3d : kBytesPerParticle2d) * scene.expected_particles();
+  return kBytesPerCase +
+         (scene.dim == 3 ? kBytesPerParticle3d : kBytesPerParticle2d) * scene.expected_particles();
 }
 
 void check_memory_fits(const std::vector<const SceneConfig*>& at_once, const std::string& what,
@@ -139,8 +141,9 @@ void check_memory_fits(const std::vector<const SceneConfig*>& at_once, const std
     if (!*room || need <= **room) continue;
     char detail[96];
     std::snprintf(detail, sizeof detail, "%.3g particles", particles);
-    throw OutOfMemoryError(what + " needs about " + bytes_text(need) + " (" + detail + ") but " + says + " " +
-                           bytes_text(std::max(0.0, **room)) + ": use a coarser numerics.dx or a smaller scene" +
+    throw OutOfMemoryError(what + " needs about " + bytes_text(need) + " (" + detail + ") but " +
+                           says + " " + bytes_text(std::max(0.0, **room)) +
+                           ": use a coarser numerics.dx or a smaller scene" +
                            (at_once.size() > 1 ? ", run fewer cases at once (--jobs)" : "") +
                            ", or free memory or raise the limit, then run the same command again");
   }

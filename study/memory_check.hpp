@@ -22,8 +22,8 @@ class OutOfMemoryError : public std::runtime_error {
 
 // What this process can still take, from each place that can refuse it; empty: no limit there.
 struct MemoryHeadroom {
-  std::optional<double> available_bytes;      // MemAvailable (/proc/meminfo)
-  std::optional<double> cgroup_bytes;         // the tightest cgroup limit on the way up, less its usage
+  std::optional<double> available_bytes;  // MemAvailable (/proc/meminfo)
+  std::optional<double> cgroup_bytes;     // the tightest cgroup limit on the way up, less its usage
   std::optional<double> address_space_bytes;  // RLIMIT_AS less the address space already mapped
 };
 

@@ -25,9 +25,11 @@ void write(const fs::path& p, const std::string& text) {
 void fake_proc(const fs::path& proc, const std::string& as_limit, const std::string& cgroup_line) {
   write(proc / "meminfo", "MemTotal:       8000000 kB\nMemAvailable:   6000000 kB\n");
   write(proc / "self" / "status", "Name:\tcrevasse\nVmSize:\t  100000 kB\nVmRSS:\t 5000 kB\n");
-  write(proc / "self" / "limits", "Limit                     Soft Limit           Hard Limit           Units\n"
-                                  "Max stack size            8388608              unlimited            bytes\n"
-                                  "Max address space         " + as_limit + "            unlimited            bytes\n");
+  write(proc / "self" / "limits",
+        "Limit                     Soft Limit           Hard Limit           Units\n"
+        "Max stack size            8388608              unlimited            bytes\n"
+        "Max address space         " +
+            as_limit + "            unlimited            bytes\n");
   write(proc / "self" / "cgroup", cgroup_line + "\n");
 }
 
@@ -119,7 +121,8 @@ void fill_noexcept(std::vector<std::unique_ptr<char[]>>& held) noexcept {
 // the new-handler gives back, memory_ran_out() turns true, the next poll throws std::bad_alloc
 // where throwing is safe, and once the memory is freed the reserve is taken again.
 TEST(MemoryReserve, TheNewHandlerGetsTheFailingAllocationThroughAndThePollThrows) {
-  if (test::kSanitized) GTEST_SKIP() << "a sanitizer's shadow memory does not fit under an address-space limit";
+  if (test::kSanitized)
+    GTEST_SKIP() << "a sanitizer's shadow memory does not fit under an address-space limit";
   EXPECT_EXIT(
       {
         rlimit limit{};
