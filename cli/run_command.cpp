@@ -20,6 +20,7 @@
 #include "engine/vtu_writer.hpp"
 #include "study/case_views.hpp"
 #include "study/engine_case.hpp"
+#include "study/memory_check.hpp"
 #include "study/memory_reserve.hpp"
 #include "study/scene_file.hpp"
 
@@ -107,6 +108,7 @@ int run_command(const RunCommandOptions& opt) {
                          {"snapshots/", "scene_resolved.json", "run_summary.json", "crevasses.csv",
                           "measurement.json", "measurements_over_time.csv", "final_particles.bin", "side_view.png",
                           "gate_view.png"});
+  check_memory_fits({&scene}, "the scene", read_memory_headroom());
   std::error_code ec;
   fs::create_directories(out / "snapshots", ec);
   if (ec)

@@ -15,7 +15,7 @@ namespace crevasse {
 template <int Dim>
 struct GridNode {
   double mass = 0.0;
-  // Σ w m (1 − D) of the particles around: the weight of the ΔJ-bar average (simulation.cpp).
+  // Σ w m (1 − D) of the particles around: the weight of the ΔJ-bar average (volume_average.hpp).
   double intact_mass = 0.0;
   Vec<Dim> vel = Vec<Dim>::Zero();  // momentum during P2G, velocity after the grid update
 };
@@ -39,7 +39,7 @@ struct Grid {
     return f;
   }
   // Flat strides per axis (x slowest: the last axis has stride 1), so that node base + off has
-  // the flat index flat(base) + Σ off[a]·stride[a] (the stencil loops of simulation.cpp). Set
+  // the flat index flat(base) + Σ off[a]·stride[a] (the stencil loops of P2G and G2P). Set
   // by reset(), with the box.
   const std::array<std::size_t, Dim>& strides() const { return stride; }
   IVec<Dim> node_of(std::size_t f) const {

@@ -527,25 +527,29 @@ void SceneConfig::resolve() {
     for (int a = 0; a < dim; ++a)
       if (!(velocity_boxes[i].max[a] > velocity_boxes[i].min[a]))
         fail("velocity_boxes[" + std::to_string(i) + "].max", "must exceed min on axis " + std::to_string(a));
-  // Lattice indices are ints and a particle costs about 0.5 kB: refuse what no machine holds.
-  double particles = std::pow(particles_per_cell_axis, dim);
-  for (int a = 0; a < dim; ++a) {
+  // Lattice indices are ints, and 1e9 particles are more than any machine holds.
+  for (int a = 0; a < dim; ++a)
     if ((domain_max[a] - domain_min[a]) / dx > 1e6)
       fail("numerics.dx", "value " + fmt(dx) + " gives more than 1e6 cells along axis " + std::to_string(a));
+  const double particles = expected_particles();
+  if (particles > 1e9)
+    fail("numerics.dx", "value " + fmt(dx) + " gives about " + fmt(particles) +
+                            " particles (limit 1e9); use a coarser dx or a smaller scene");
+}
+
+double SceneConfig::expected_particles() const {
+  double particles = std::pow(particles_per_cell_axis, dim);
+  for (int a = 0; a < dim; ++a) {
     const double ice = body == Body::box ? box_max[a] - box_min[a]
                        : a == 0      ? upstream_length + draped_length
                        : a == dim - 1 ? ice_thickness
                                       : width;
     particles *= ice / dx;
   }
-  if (particles > 1e9)
-    fail("numerics.dx", "value " + fmt(dx) + " gives about " + fmt(particles) +
-                            " particles (limit 1e9); use a coarser dx or a smaller scene");
+  return particles;
 }
 
 namespace {
-
-
 
 // "[a]": built by appending, because g++ 12 warns falsely (-Wrestrict) on "[" + to_string(a).
 std::string index_suffix(long a) {

@@ -44,7 +44,7 @@ enum class DriveStart { ramp, moving };
 // What drives the glacier at its back. piston: the back layer of the slab is pushed at V_x, so
 // the slab behind the step is consumed and the push grows with its length. inflow: the grid
 // nodes at the back of the domain move at V_x and ice enters there, a copy of the ice just
-// inside (Simulation::inflow), so the upstream ice is only as long as upstream_length.
+// inside (engine/inflow.hpp), so the upstream ice is only as long as upstream_length.
 enum class DriveBoundary { piston, inflow };
 const char* kind_name(Body k);
 const char* kind_name(BedShape k);
@@ -188,6 +188,8 @@ struct SceneConfig : ScenePhysics, SceneNumerics, SceneRun, SceneOutput {
   double drive_velocity(double t) const;  // piston speed at time t [m/s]
   double drive_position(double t) const;  // piston face x at time t (0 at t = 0) [m]
   double implied_fracture_energy() const;  // G = c·dx/ζ [J/m²] (band width h = dx)
+  // Particles seeded at the start: the ice box, or the slab, over the particle spacing.
+  double expected_particles() const;
   // Equivalent plastic strain rate per q^n in simulated time: (2/√3)·A·(q/√3)^n, Glen's law in
   // von Mises terms, sped up as the drive is (real time when there is no drive); 0 without creep.
   double creep_rate() const;

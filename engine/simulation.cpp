@@ -18,13 +18,11 @@
 #include "engine/grid_boundaries.hpp"
 #include "engine/particle_update.hpp"
 #include "engine/seeding.hpp"
+#include "engine/velocity_gather.hpp"
 
 namespace crevasse {
 namespace {
 
-// P2G colouring: a particle with stencil base b writes nodes b..b+2 along x. Slabs of 4 cells
-// write 6 node columns, so slabs of one parity never share a node and run in parallel.
-constexpr int kSlabCells = 4;
 // Re-sorting particles by cell restores memory locality; every ~100 steps costs ~1% and never
 // costs ~17% (docs/performance.md).
 constexpr int kSortInterval = 100;
@@ -66,6 +64,10 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   if (bed_) bed_field_ = BedField<Dim>(*bed_, domain_lo_, domain_hi_, scene_.dx);
   particles_ = seed_ice<Dim>(scene_, moduli_, bed_ ? &*bed_ : nullptr);
   if (scene_.records_gate()) gate_ = GateRecorder<Dim>(particles_, scene_.gate_x());
+  average_ = VolumeAverage<Dim>(scene_);
+  outflow_ = Outflow<Dim>(domain_hi_[0] - 3.0 * scene_.dx);
+  inflow_ = Inflow<Dim>(scene_.dx / scene_.particles_per_cell_axis);
+  downstream_ = DownstreamImpulseMeter<Dim>(domain_hi_[0] - (kDownstreamDriveCells + 1.0) * scene_.dx);
   if (scene_.body == Body::slab && scene_.has(Effect::gravity)) {
     // No particle of a slab can go faster than free fall from the top of the ice to the floor
     // plus twice the drive (a block pushed off at V_x and rebounding); 1.5× that is a margin
@@ -94,21 +96,18 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   if (scene_.has(Effect::basal_friction))
     add_stage("basal_friction", [this] { apply_bed_friction(grid_, bed_field_, scene_.bed_friction); });
   if (has_inflow) {
-    // The nodes up to kInflowHoldCells from the back move at V(t) along x, free vertically.
+    // The nodes up to Inflow::kHoldCells from the back move at V(t) along x, free vertically.
     // Every particle within 2.5 cells of the back has its whole stencil on them, so it moves at
     // exactly V(t) and its F_E sees the same velocity field as its position does; the ice ahead
     // is pushed through the grid, and its compression is stress.
     add_stage("inflow_grid", [this] {
-      hold_nodes_at_speed(grid_, -kInfinity, kInflowHoldCells * scene_.dx, drive_speed_now(), false);
+      hold_nodes_at_speed(grid_, -kInfinity, Inflow<Dim>::kHoldCells * scene_.dx, drive_speed_now(), false);
     });
   }
   // The boundary stages between these two brackets are the only ones that can act on the
-  // downstream band (bed friction and gravity come before); their change of its momentum is the
-  // impulse the domain's end gives the ice. The band is a contiguous tail of the nodes (x is
-  // the slowest axis), a few columns: negligible next to the step.
+  // downstream band (engine/downstream_meter.hpp). Read the nodes' mass and velocity.
   const bool glacier = scene_.body == Body::slab;
-  if (glacier)
-    add_stage("downstream_band_before", [this] { downstream_before_z_ = downstream_band_momentum_z(); });
+  if (glacier) add_stage("downstream_band_before", [this] { downstream_.before(grid_); });
   if (scene_.has(Effect::downstream_drive)) {
     // The glacier goes on past the domain: the nodes of the last cells before the outflow line
     // move with it, at (V(t), 0) on the flat floor. Without this the floor ice is free to be
@@ -128,33 +127,32 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
     add_stage("velocity_boundaries", [this] { apply_velocity_boxes(grid_, scene_.velocity_boxes, time_); });
   if (glacier)
     add_stage("downstream_band_after", [this] {
-      if (!settling_) downstream_impulse_z_ += downstream_band_momentum_z() - downstream_before_z_;
+      if (!settling_.active) downstream_.after(grid_);
     });
   if (scene_.settle_time > 0.0) {
-    // Damping exists only while settling: one branch per step, none per particle.
-    settle_damping_rate_ = scene_.p_wave_speed() /
-                           (scene_.body == Body::slab ? scene_.ice_thickness
-                                                  : scene_.box_max[Dim - 1] - scene_.box_min[Dim - 1]);
-    add_stage("settle_damping", [this] {
-      if (!settling_) return;
-      const double f = std::exp(-settle_damping_rate_ * dt_);
-      for (auto& g : grid_.nodes) g.vel *= f;
-    });
+    settling_.damping_rate = Settling::damping_rate_of<Dim>(scene_);
+    add_stage("settle_damping", [this] { settling_.damp(grid_, dt_); });  // the nodes' velocity
   }
   const bool plastic = scene_.has(Effect::plasticity);
   // The particle update: with the average, after a sweep that gathers the velocities and
   // scatters the volume change; without, the gather is fused into it.
   const bool average = scene_.volumetric_averaging;
+  // The averaging stages read and write what engine/volume_average.hpp says of each.
   if (average) {
-    add_stage("g2p_velocity", [this] { gather_velocities_and_scatter_volume(); });
-    add_stage("volume_averaging", [this] { normalise_volume_average(); });
-    if (scene_.average_per_cell) add_stage("cell_average", [this] { average_over_cells(); });
+    add_stage("g2p_velocity", [this] {
+      average_.gather_and_scatter(particles_, grid_, colouring_, dt_, averaging_weights_damage());
+    });
+    add_stage("volume_averaging", [this] { average_.normalise(grid_); });
+    if (scene_.average_per_cell)
+      add_stage("cell_average", [this] {
+        average_.average_over_cells(particles_, grid_, colouring_, dt_, averaging_weights_damage());
+      });
   }
   if (plastic) {
     // No return mapping while settling: the settled state is elastic by construction.
     add_stage("g2p_return_mapping", [this, average] {
-      if (average) settling_ ? update_particles<false, true>() : update_particles<true, true>();
-      else settling_ ? update_particles<false, false>() : update_particles<true, false>();
+      if (average) settling_.active ? update_particles<false, true>() : update_particles<true, true>();
+      else settling_.active ? update_particles<false, false>() : update_particles<true, false>();
     });
   } else {
     add_stage("g2p_elastic", [this, average] {
@@ -187,28 +185,28 @@ void Simulation<Dim>::add_stage(std::string name, std::function<void()> run) {
 
 template <int Dim>
 bool Simulation<Dim>::settle(const std::function<bool()>& keep_going) {
-  if (settled_) return true;
+  if (settling_.done) return true;
   if (scene_.settle_time <= 0.0) {
-    settled_ = true;
+    settling_.done = true;
     return true;
   }
-  // settled_ stays false until the phase ends, so that a checkpoint written while settling
-  // (between steps, through keep_going) resumes the phase where it stood.
-  settling_ = true;
+  // settling_.done stays false until the phase ends, so that a checkpoint written while
+  // settling (between steps, through keep_going) resumes the phase where it stood.
+  settling_.active = true;
   while (time_ < scene_.settle_time) {
     step();
     if (keep_going && !keep_going()) {
-      settling_ = false;
+      settling_.active = false;
       return false;
     }
   }
-  settling_ = false;
-  settled_ = true;
+  settling_.active = false;
+  settling_.done = true;
   for (std::size_t p = 0; p < particles_.size(); ++p) {
     particles_.v[p].setZero();
     particles_.C[p].setZero();
   }
-  if (scene_.drive_start == DriveStart::moving) start_moving();
+  if (scene_.drive_start == DriveStart::moving) set_sliding(particles_, scene_.drive_speed);
   time_ = 0.0;
   steps_ = 0;
   particle_steps_ = 0;
@@ -219,18 +217,8 @@ bool Simulation<Dim>::settle(const std::function<bool()>& keep_going) {
 }
 
 template <int Dim>
-void Simulation<Dim>::start_moving() {
-  // The settled glacier is set sliding as a rigid body at V_x, the speed the drives hold from
-  // t = 0: a rigid translation carries no stress, so the start sends no wave through the ice,
-  // however long it is. Ice over the ramp then settles onto its bed under gravity; a start with
-  // each column already following the bed (v_z = V_x z_b'(x)) has a jump of v_z at the lip and
-  // the foot, and cracked both at once (twice the damaged particles after 1 s at H_i = 200 m).
-  for (std::size_t p = 0; p < particles_.size(); ++p) particles_.v[p][0] = scene_.drive_speed;
-}
-
-template <int Dim>
 void Simulation<Dim>::step() {
-  if (!settled_ && !settling_) settle();
+  if (!settling_.done && !settling_.active) settle();
   for (std::size_t s = 0; s < stage_fns_.size(); ++s) {
     const auto t0 = std::chrono::steady_clock::now();
     stage_fns_[s].run();
@@ -245,8 +233,7 @@ void Simulation<Dim>::prepare_grid() {
   const std::size_t n = P.size();
   if (n == 0) {
     grid_.reset(IVec<Dim>::Zero(), IVec<Dim>::Ones());
-    slab_start_.assign(2, 0);
-    slab_order_.clear();
+    colouring_.clear();
     return;
   }
   const double inv_dx = 1.0 / scene_.dx;
@@ -290,43 +277,7 @@ void Simulation<Dim>::prepare_grid() {
       });
   grid_.reset(box.first, (box.second - box.first).array() + 1);
 
-  // Counting sort of particle indices into x-slabs, stable: within a slab the particles keep
-  // their index order, so P2G sums in a fixed order and is deterministic whatever the thread
-  // count. Parallel over a fixed number of index blocks (not one per thread, so the result
-  // never depends on the thread count): each block counts its particles per slab, a prefix
-  // over (slab, block) gives each block its place in every slab, and each block then fills
-  // its places in index order, which is exactly the serial stable order.
-  const std::size_t slabs = static_cast<std::size_t>((grid_.n[0] + kSlabCells - 1) / kSlabCells);
-  const std::size_t blocks = std::min<std::size_t>(64, (n + kGrain - 1) / kGrain);
-  const std::size_t block_size = (n + blocks - 1) / blocks;
-  const int lo_x = grid_.lo[0];
-  const auto slab_of = [&](std::size_t p) {
-    const int b = floor_to_int(P.x[p][0] * inv_dx - 0.5) - lo_x;
-    return static_cast<std::size_t>(b / kSlabCells);
-  };
-  auto& offsets = slab_block_offsets_;  // [block][slab]
-  offsets.assign(blocks * slabs, 0);
-  tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t k) {
-    std::uint32_t* count = offsets.data() + k * slabs;
-    for (std::size_t p = k * block_size, e = std::min(n, p + block_size); p < e; ++p) ++count[slab_of(p)];
-  });
-  slab_start_.assign(slabs + 1, 0);
-  std::uint32_t at = 0;
-  for (std::size_t s = 0; s < slabs; ++s) {
-    slab_start_[s] = at;
-    for (std::size_t k = 0; k < blocks; ++k) {
-      const std::uint32_t c = offsets[k * slabs + s];
-      offsets[k * slabs + s] = at;
-      at += c;
-    }
-  }
-  slab_start_[slabs] = at;
-  slab_order_.resize(n);
-  tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t k) {
-    std::uint32_t* place = offsets.data() + k * slabs;
-    for (std::size_t p = k * block_size, e = std::min(n, p + block_size); p < e; ++p)
-      slab_order_[place[slab_of(p)]++] = static_cast<std::uint32_t>(p);
-  });
+  colouring_.build(P, grid_);
 }
 
 template <int Dim>
@@ -343,14 +294,14 @@ void Simulation<Dim>::scatter_to_grid() {
   const double d_inv = 4.0 * inv_dx * inv_dx;  // MLS inertia-like tensor inverse for quadratic B-splines
   const double dt = dt_;
   // With the ΔJ-bar average, each particle also adds its intact mass m (1 − D), the weight of
-  // the average (gather_velocities_and_scatter_volume), and keeps its e^{−ζ ε_v^p} for the
-  // sweeps after (ε_v^p does not change before the update).
+  // the average, and keeps its e^{−ζ ε_v^p} for the sweeps after (ε_v^p does not change before
+  // the update).
   const bool plastic = Average && !P.eps_v_p.empty();
   const bool damage = Average && averaging_weights_damage();
-  softening_.resize(plastic ? P.size() : 0);
+  average_.keep_softening_of(plastic ? P.size() : 0);
   const std::array<std::size_t, Dim> stride = grid_.strides();
   GridNode<Dim>* const nodes = grid_.nodes.data();
-  for_each_particle_coloured([&](std::uint32_t p) __attribute__((always_inline)) {
+  colouring_.for_each([&](std::uint32_t p) __attribute__((always_inline)) {
     const Vec<Dim> xg = P.x[p] * inv_dx;
     const StencilWeights<Dim> w(xg);
     const double m = P.mass[p];
@@ -361,8 +312,8 @@ void Simulation<Dim>::scatter_to_grid() {
     double wm = 0.0;
     if constexpr (Average) {
       const double f = plastic ? softening_factor(plastic_, P.eps_v_p[p]) : 1.0;
-      if (plastic) softening_[p] = f;
-      wm = averaging_weight(p, damage);
+      if (plastic) average_.keep_softening(p, f);
+      wm = average_.weight(P, p, damage);
     }
     // affine·Δx per node from per-axis products, the doubles of affine * Δx (AffineTerms).
     const AffineTerms<Dim> ad(affine, StencilOffsets<Dim>(w, xg, dx));
@@ -377,20 +328,6 @@ void Simulation<Dim>::scatter_to_grid() {
 }
 
 template <int Dim>
-template <class Fn>
-void Simulation<Dim>::for_each_particle_coloured(Fn&& fn) {
-  // Race-free scatter: slabs of one parity share no grid node, so they run in parallel; the
-  // order inside a slab is fixed, so sums are deterministic whatever the thread count.
-  const int slabs = static_cast<int>(slab_start_.size()) - 1;
-  for (int colour = 0; colour < 2; ++colour) {
-    tbb::parallel_for(0, (slabs + 1 - colour) / 2, [&](int half) {
-      const int s = 2 * half + colour;
-      for (std::uint32_t q = slab_start_[s]; q < slab_start_[s + 1]; ++q) fn(slab_order_[q]);
-    });
-  }
-}
-
-template <int Dim>
 void Simulation<Dim>::grid_velocity(const Vec<Dim>& gravity) {
   const double dt = dt_;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid_.node_count(), kGrain), [&](const auto& r) {
@@ -401,170 +338,16 @@ void Simulation<Dim>::grid_velocity(const Vec<Dim>& gravity) {
 }
 
 template <int Dim>
-[[gnu::always_inline]] inline void Simulation<Dim>::gather_velocity(std::size_t p, const StencilWeights<Dim>& w,
-                                                                    const StencilOffsets<Dim>& d, std::size_t f0,
-                                                                    double c_scale) {
-  // APIC/MLS gather of the particle velocity and its affine matrix C = c_scale·B (c_scale =
-  // 4/dx², formed once by the caller) from the grid (gather_apic); f0 = flat index of the
-  // stencil's base node.
-  const GridNode<Dim>* const nodes = grid_.nodes.data();
-  Vec<Dim> v;
-  Mat<Dim> b;
-  gather_apic<Dim>(w, d, f0, grid_.strides(),
-                   [nodes](std::size_t f) -> const Vec<Dim>& { return nodes[f].vel; }, v, b);
-  particles_.v[p] = v;
-  particles_.C[p] = c_scale * b;
-}
-
-// ΔJ-bar (cf. the F-bar family, e.g. Coombs et al. 2018, CMAME 333:1–21): the step's volume
-// ratio ΔJ_p = det(I + Δt C_p) is mass-averaged onto the grid nodes with the same quadratic
-// weights as P2G and interpolated back; each particle then takes the averaged ΔJ̄_p and keeps
-// its own isochoric part. A field that varies linearly over the stencil is reproduced, so a
-// smooth deformation is unchanged; a particle-to-particle checkerboard is removed.
-// Only intact ice is averaged: each particle enters with weight (1 − D) (D the damage,
-// 1 − e^{−ζ ε_v^p}) and takes ΔJ_used = (1 − D)·ΔJ̄ + D·ΔJ_p. An opening crack then keeps its
-// volume change to itself instead of handing part of it to the intact ice around it, which
-// would widen every crack by a cell each time it opens further.
-// Three passes, fused with G2P: (1) one coloured sweep gathers v and C and scatters
-// (1 − D) m ΔJ and (1 − D) m with the same weights; (2) per node, the average; (3) the update
-// sweep interpolates ΔJ̄ back, recomputing ΔJ_p from C (unchanged since (1)). The softening
-// factor e^{−ζ ε_v^p} (= 1 − D) is kept per particle from (1) to (3), where the return mapping
-// uses it for its cap check and shear strength: a particle that stays off the cap evaluates one
-// exponential per step instead of three, and none while intact (e^{−ζ·0} = 1 is not evaluated).
-template <int Dim>
 bool Simulation<Dim>::averaging_weights_damage() const {
   // Broken ice is left out of the average only once it can break: not while settling, not
   // without softening.
-  return particles_.has_plastic_state() && plastic_.softening_zeta > 0.0 && !settling_;
-}
-
-template <int Dim>
-void Simulation<Dim>::gather_velocities_and_scatter_volume() {
-  auto& P = particles_;
-  const double dx = scene_.dx, inv_dx = 1.0 / dx, c_scale = 4.0 * inv_dx * inv_dx;
-  const bool damage = averaging_weights_damage();
-  const bool per_cell = scene_.average_per_cell;
-  grid_aux_.assign(2 * grid_.node_count(), 0.0);  // per node Σ w m (1−D) ΔJ (and ΔJ J_E), then (ΔJ̄, has one)
-  double* const aux = grid_aux_.data();
-  const bool relax = per_cell && scene_.average_relaxation_time > 0.0;
-  grid_total_.resize(relax ? grid_.node_count() : 0);  // written by normalise_volume_average
-  const std::array<std::size_t, Dim> stride = grid_.strides();
-  for_each_particle_coloured([&](std::uint32_t p) __attribute__((always_inline)) {
-    const Vec<Dim> xg = P.x[p] * inv_dx;
-    const StencilWeights<Dim> w(xg);
-    const std::size_t f0 = grid_.flat(w.base());
-    gather_velocity(p, w, StencilOffsets<Dim>(w, xg, dx), f0, c_scale);
-    const double dj = per_cell ? step_volume_ratio(p) : averaged_volume_ratio(p);
-    const double wm = averaging_weight(p, damage);  // the weight P2G added to intact_mass
-    if (relax) {
-      // The whole volume's sum goes in each node's second slot, free until the normalisation.
-      const double jt = dj * P.F_e[p].determinant();
-      for_each_stencil_node<Dim>(w, f0, stride, [&](const IVec<Dim>&, std::size_t f, double wt) {
-        aux[2 * f] += wt * wm * dj;
-        aux[2 * f + 1] += wt * wm * jt;
-      });
-      return;
-    }
-    for_each_stencil_node<Dim>(w, f0, stride,
-                               [&](const IVec<Dim>&, std::size_t f, double wt) { aux[2 * f] += wt * wm * dj; });
-  });
-}
-
-template <int Dim>
-void Simulation<Dim>::normalise_volume_average() {
-  // Per node, once: the averaged ΔJ and whether the node carries one (nodes reached only by
-  // (nearly) broken ice do not).
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid_.node_count(), kGrain), [&](const auto& r) {
-    for (std::size_t f = r.begin(); f != r.end(); ++f) {
-      const double intact = grid_.nodes[f].intact_mass;
-      const bool has = intact > 1e-9 * grid_.nodes[f].mass;
-      if (!grid_total_.empty()) grid_total_[f] = has ? grid_aux_[2 * f + 1] / intact : 0.0;
-      grid_aux_[2 * f] = has ? grid_aux_[2 * f] / intact : 0.0;
-      grid_aux_[2 * f + 1] = has ? 1.0 : 0.0;
-    }
-  });
-}
-
-template <int Dim>
-void Simulation<Dim>::average_over_cells() {
-  // numerics.average_per_cell: each particle's trial elastic volume ratio, its own elastic
-  // volume times the stencil-averaged step ratio, is averaged over the particles of its grid
-  // cell (weights as in the nodal average); the update gives it the cell's mean.
-  auto& P = particles_;
-  const double inv_dx = 1.0 / scene_.dx;
-  const bool damage = averaging_weights_damage();
-  cell_aux_.assign(2 * grid_.node_count(), 0.0);
-  double* const aux = cell_aux_.data();
-  for_each_particle_coloured([&](std::uint32_t p) __attribute__((always_inline)) {
-    const Vec<Dim> xg = P.x[p] * inv_dx;
-    const StencilWeights<Dim> w(xg);
-    const Vec<2> sums = stencil_sums(w);
-    const double dj = step_volume_ratio(p);
-    const double share = damage ? softening_[p] : 1.0;
-    const double total = volume_scale_of(sums[0], sums[1], dj, share) * dj * P.F_e[p].determinant();
-    const double wm = averaging_weight(p, damage);
-    const std::size_t c = grid_.flat(cell_of(xg));
-    aux[2 * c] += wm * total;
-    aux[2 * c + 1] += wm;
-  });
-  // The nodes' ΔJ̄ has served; with the relaxation, their whole-volume average takes its slot,
-  // beside the flag the update needs with it.
-  const bool relax = !grid_total_.empty();
-  double* const nodal = grid_aux_.data();
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, grid_.node_count(), kGrain), [&](const auto& r) {
-    for (std::size_t f = r.begin(); f != r.end(); ++f) {
-      const bool has = aux[2 * f + 1] > 0.0;
-      aux[2 * f] = has ? aux[2 * f] / aux[2 * f + 1] : 0.0;
-      aux[2 * f + 1] = has ? 1.0 : 0.0;
-      if (relax) nodal[2 * f] = grid_total_[f];
-    }
-  });
-}
-
-template <int Dim>
-[[gnu::always_inline]] inline Vec<2> Simulation<Dim>::stencil_sums(const StencilWeights<Dim>& w) const {
-  // (Σ w·first, Σ w·flag) over the stencil from grid_aux_'s pairs (each node's two slots
-  // adjacent: one vector load per node).
-  const double* const aux = grid_aux_.data();
-  Vec<2> sums = Vec<2>::Zero();
-  for_each_stencil_node<Dim>(w, grid_.flat(w.base()), grid_.strides(),
-                             [&](const IVec<Dim>&, std::size_t f, double wt) {
-    sums += wt * Eigen::Map<const Vec<2>>(aux + 2 * f);
-  });
-  return sums;
-}
-
-template <int Dim>
-[[gnu::always_inline]] inline typename Simulation<Dim>::VolumeSums Simulation<Dim>::volume_sums(
-    std::size_t p, const StencilWeights<Dim>& w) const {
-  // The stencil's Σ w ΔJ̄ and Σ w, or with numerics.average_per_cell the cell's mean and
-  // whether it has one, and ΔJ_p of particle p (before its update moves it).
-  VolumeSums v{0.0, 0.0, 0.0};
-  v.dj = averaged_volume_ratio(p);
-  if (scene_.average_per_cell) {
-    const std::size_t c = grid_.flat(cell_of(particles_.x[p] / scene_.dx));
-    v.jbar = cell_aux_[2 * c];
-    v.wsum = cell_aux_[2 * c + 1];
-    if (!grid_total_.empty()) {
-      // Relaxed towards the stencil's whole-volume average at the rate 1/τ (a particle whose
-      // stencil carries none, towards its own).
-      const Vec<2> st = stencil_sums(w);  // grid_aux_ holds (T̄, has one) now
-      const double target = st[1] > 0.0 ? st[0] / st[1] : v.dj;
-      const double a = std::min(1.0, dt_ / scene_.average_relaxation_time);
-      v.jbar = (1.0 - a) * v.jbar + a * target;
-    }
-    return v;
-  }
-  const Vec<2> sums = stencil_sums(w);
-  v.jbar = sums[0];
-  v.wsum = sums[1];
-  return v;
+  return particles_.has_plastic_state() && plastic_.softening_zeta > 0.0 && !settling_.active;
 }
 
 template <int Dim>
 ParticleEffects<Dim> Simulation<Dim>::particle_effects_now() const {
   ParticleEffects<Dim> e = effects_;
-  if (e.piston && !settling_) {
+  if (e.piston && !settling_.active) {
     // The piston's place at the end of this step: finish_step's time_ + dt_.
     const double end_time = time_ + dt_;
     e.piston_shift = scene_.drive_position(end_time);
@@ -579,23 +362,23 @@ void Simulation<Dim>::update_particles() {
   auto& P = particles_;
   const double dx = scene_.dx, inv_dx = 1.0 / dx, c_scale = 4.0 * inv_dx * inv_dx;
   const bool damage = Average && averaging_weights_damage();
-  const bool kept_softening = !softening_.empty();  // P2G kept e^{−ζ ε_v^p} (averaged, plastic)
+  const bool kept_softening = average_.kept_softening();  // P2G kept e^{−ζ ε_v^p} (averaged, plastic)
   const ParticleEffects<Dim> effects = particle_effects_now();
   plastic_.creep_increment = dt_ * creep_rate_;
   // What the update needs of particle p first: with the average, its stencil's sums (its velocity
-  // was gathered by gather_velocities_and_scatter_volume); without, the gather itself.
+  // was gathered by average_.gather_and_scatter); without, the gather itself.
   const auto inputs = [&](std::size_t p, double& jbar, double& wsum, double& dj,
                           double& soft) __attribute__((always_inline)) {
     const Vec<Dim> xg = P.x[p] * inv_dx;
     const StencilWeights<Dim> w(xg);
     if constexpr (Average) {
-      const VolumeSums v = volume_sums(p, w);
+      const typename VolumeAverage<Dim>::Sums v = average_.sums(P, grid_, p, w, dt_);
       jbar = v.jbar;
       wsum = v.wsum;
       dj = v.dj;
-      soft = kept_softening ? softening_[p] : 1.0;
+      soft = kept_softening ? average_.softening(p) : 1.0;
     } else {
-      gather_velocity(p, w, StencilOffsets<Dim>(w, xg, dx), grid_.flat(w.base()), c_scale);
+      gather_velocity(P, grid_, p, w, StencilOffsets<Dim>(w, xg, dx), grid_.flat(w.base()), c_scale);
       soft = Plastic ? softening_factor(plastic_, P.eps_v_p[p]) : 1.0;
     }
   };
@@ -636,74 +419,19 @@ void Simulation<Dim>::finish_step() {
 }
 
 template <int Dim>
-double Simulation<Dim>::downstream_band_momentum_z() const {
-  const double x0 = domain_hi_[0] - (kDownstreamDriveCells + 1.0) * scene_.dx;
-  const long first_column = static_cast<long>(std::ceil(x0 / grid_.dx)) - grid_.lo[0];
-  if (first_column >= grid_.n[0]) return 0.0;
-  double pz = 0.0;
-  for (std::size_t f = static_cast<std::size_t>(std::max(0L, first_column)) * grid_.stride[0];
-       f < grid_.nodes.size(); ++f)
-    pz += grid_.nodes[f].mass * grid_.nodes[f].vel[up_axis<Dim>];
-  return pz;
-}
-
-template <int Dim>
 void Simulation<Dim>::remove_outflow() {
-  // Ice within three cells of the downstream end has left the scene (docs/model.md).
-  const double x_out = domain_hi_[0] - 3.0 * scene_.dx;
-  auto& P = particles_;
-  // Most steps remove nothing. The update's summary holds the front (its largest x), so those
-  // steps cost nothing; otherwise find the first particle past the line. The particles are
-  // sorted with x slowest, so those past it sit near the end and everything before the first
-  // stays where it is.
-  if (summary_step_ == steps_ && summary_.bad < 0 && summary_.front < x_out) return;
-  const std::size_t n = P.size();
-  const std::size_t first = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, n, kGrain), n,
-      [&](const auto& r, std::size_t found) {
-        for (std::size_t p = r.begin(); p != r.end() && p < found; ++p)
-          if (!(P.x[p][0] < x_out)) found = p;
-        return found;
-      },
-      [](std::size_t a, std::size_t b) { return std::min(a, b); });
-  if (first == n) return;
-  std::vector<char> keep(n, 1);
-  for (std::size_t p = first; p < n; ++p) keep[p] = P.x[p][0] < x_out;
-  if (records_gate()) gate_.archive_removed(P, keep, first);
-  removed_mass_ += P.compact(keep, first);
-  summary_step_ = -1;  // the update's summary counted the removed particles
+  // Most steps remove nothing: the update's summary holds the front (its largest x) when it is
+  // this step's and counted every particle.
+  const bool known = summary_step_ == steps_ && summary_.bad < 0;
+  if (outflow_.remove(particles_, records_gate() ? &gate_ : nullptr,
+                      known ? std::optional<double>(summary_.front) : std::nullopt))
+    summary_step_ = -1;  // the update's summary counted the removed particles
 }
 
 template <int Dim>
 void Simulation<Dim>::inflow() {
-  // The ice within 2.5 cells of the back moves at exactly the drive speed (drive_inflow_nodes).
-  // Each time the drive has moved by one particle spacing h, the band of ice h wide that entered
-  // last, now at x ∈ [h, 2h), is copied h further back, into the place it has left: the same
-  // F_E, stress, mass, velocity and height, so the ice enters settled and loaded, with no step in
-  // its state. Serial, once every h/V_x of simulated time.
-  if (settling_) return;
-  auto& P = particles_;
-  const double h = scene_.dx / scene_.particles_per_cell_axis;
-  const double s = scene_.drive_position(time_);
-  const auto due = static_cast<std::int64_t>(std::floor(s / h));  // columns entered by now
-  for (; inflow_columns_ < due; ++inflow_columns_) {
-    // The band's place when the drive had moved k h, plus what it has moved since.
-    const double since = s - static_cast<double>(inflow_columns_ + 1) * h;
-    const double lo = h + since, hi = 2.0 * h + since;
-    const std::size_t n = P.size();
-    for (std::size_t q = 0; q < n; ++q) {
-      if (!(P.x[q][0] >= lo && P.x[q][0] < hi)) continue;
-      Vec<Dim> pos = P.x[q];
-      pos[0] -= h;
-      P.push_back(pos, P.mass[q], P.vol0[q], P.F_e[q], P.tau[q]);
-      P.v.back() = P.v[q];
-      P.C.back() = P.C[q];
-      if (P.has_plastic_state()) P.eps_v_p.push_back(0.0);
-      if (records_gate()) GateRecorder<Dim>::add_entering(P, pos, s);
-      inflow_mass_ += P.mass[q];
-    }
-    summary_step_ = -1;  // the update's summary did not see the new ice
-  }
+  if (settling_.active) return;
+  if (inflow_.feed(particles_, scene_.drive_position(time_))) summary_step_ = -1;  // it did not see the new ice
 }
 
 template <int Dim>
@@ -747,7 +475,7 @@ void Simulation<Dim>::update_time_step() {
   // Where an error happened (built only on the error paths below; this runs every step).
   // During settling the step count and time restart at 0 afterwards: say so.
   const auto when = [&] {
-    return (settling_ ? "settling (before t = 0), step " : "step ") + std::to_string(steps_) +
+    return (settling_.active ? "settling (before t = 0), step " : "step ") + std::to_string(steps_) +
            ", t = " + std::to_string(time_);
   };
   // The particle with the largest speed (only on the error paths below).
@@ -796,9 +524,9 @@ void Simulation<Dim>::update_time_step() {
 
 template <int Dim>
 void Simulation<Dim>::save_checkpoint(const std::string& path, std::optional<double> wall_s) const {
-  const RunCounters run{time_,         dt_,     steps_,    particle_steps_, return_map_evaluations_,
-                        removed_mass_, front_x_, max_speed_, settled_,       inflow_mass_,
-                        inflow_columns_, wall_s};
+  const RunCounters run{time_,           dt_,       steps_,           particle_steps_,
+                        return_map_evaluations_, outflow_.removed_mass(), front_x_, max_speed_,
+                        settling_.done,  inflow_.mass(), inflow_.columns(), wall_s};
   crevasse::save_checkpoint(path, scene_, run, particles_, gate_);
 }
 
@@ -807,9 +535,9 @@ std::optional<double> Simulation<Dim>::load_checkpoint(const std::string& path) 
   RunCounters r;
   crevasse::load_checkpoint(path, scene_, r, particles_, gate_);
   time_ = r.time; dt_ = r.dt; steps_ = r.steps; particle_steps_ = r.particle_steps;
-  return_map_evaluations_ = r.return_map_evaluations; removed_mass_ = r.removed_mass; front_x_ = r.front_x;
-  max_speed_ = r.max_speed; settled_ = r.settled; settling_ = false;
-  inflow_mass_ = r.inflow_mass; inflow_columns_ = r.inflow_columns;
+  return_map_evaluations_ = r.return_map_evaluations; outflow_.set_removed_mass(r.removed_mass); front_x_ = r.front_x;
+  max_speed_ = r.max_speed; settling_.done = r.settled; settling_.active = false;
+  inflow_.restore(r.inflow_mass, r.inflow_columns);
   return r.wall_s;
 }
 

@@ -16,14 +16,20 @@
 #include "engine/bed_field.hpp"
 #include "engine/bspline.hpp"
 #include "engine/capped_von_mises.hpp"
+#include "engine/downstream_meter.hpp"
 #include "engine/gate_recorder.hpp"
 #include "engine/grid.hpp"
 #include "engine/hencky.hpp"
+#include "engine/inflow.hpp"
+#include "engine/outflow.hpp"
+#include "engine/particle_colouring.hpp"
 #include "engine/particle_effects.hpp"
 #include "engine/particles.hpp"
 #include "engine/readouts.hpp"
 #include "engine/scene.hpp"
+#include "engine/settling.hpp"
 #include "engine/snapshot.hpp"
+#include "engine/volume_average.hpp"
 
 namespace crevasse {
 
@@ -44,7 +50,7 @@ class Simulation {
   // limit and checkpoints); when it returns false the phase pauses and settle() returns false.
   // The next settle() or step() continues it, as does a checkpoint written meanwhile.
   bool settle(const std::function<bool()>& keep_going = {});
-  bool settled() const { return settled_; }
+  bool settled() const { return settling_.done; }
 
   double time() const { return time_; }
   double last_dt() const { return dt_; }
@@ -65,8 +71,8 @@ class Simulation {
 
   // Diagnostics (conservation checks, hard-case assertions; engine/readouts.hpp).
   double total_mass() const { return crevasse::total_mass(particles_); }
-  double removed_mass() const { return removed_mass_; }
-  double inflow_mass() const { return inflow_mass_; }  // mass that entered through the inflow
+  double removed_mass() const { return outflow_.removed_mass(); }
+  double inflow_mass() const { return inflow_.mass(); }  // mass that entered through the inflow
   Vec<Dim> total_momentum() const { return crevasse::total_momentum(particles_); }
   double kinetic_energy() const { return crevasse::kinetic_energy(particles_); }
   double gravitational_potential_energy() const {
@@ -85,7 +91,7 @@ class Simulation {
   // nodes, walls, velocity boxes) has given the ice since the settling phase: the change of
   // vertical grid momentum those boundary stages make in the last cells before the domain's
   // end. Nothing downstream may carry the glacier (docs/model.md). Not checkpointed.
-  double downstream_impulse_z() const { return downstream_impulse_z_; }
+  double downstream_impulse_z() const { return downstream_.impulse_z(); }
 
   ParticleSnapshot snapshot() const {
     return make_snapshot(particles_, scene_, plastic_, time_, bed(), records_gate() ? &gate_ : nullptr);
@@ -128,83 +134,33 @@ class Simulation {
   // (engine/grid_boundaries.hpp) read the nodes' mass and velocity and write the velocity.
   // Every step: re-sorts the particles by cell (every kSortInterval steps), fits the grid's
   // box to them and builds the P2G colouring. Reads x; writes the particle order, grid_ (empty),
-  // slab_order_, slab_start_.
+  // colouring_.
   void prepare_grid();
   // P2G. Reads x, v, C, τ, mass, V0 (and ε_v^p with the average); writes the nodes' mass,
-  // momentum (and intact_mass, softening_ with the average).
+  // momentum (and intact_mass, and the average's kept softening).
   void particle_to_grid();
   template <bool Average>
   void scatter_to_grid();  // P2G, with the ΔJ-bar average's weights when Average
-  template <class Fn>
-  void for_each_particle_coloured(Fn&& fn);  // race-free P2G-style traversal by x-slab parity
   // Momentum to velocity, plus gravity. Reads and writes the nodes' velocity.
   void grid_velocity(const Vec<Dim>& gravity);
-  double drive_speed_now() const { return settling_ ? 0.0 : scene_.drive_velocity(time_); }
-  // The inflow holds the nodes up to this many cells from the back: a quadratic stencil reaches
-  // 1.5 cells, so the ice within 2.5 cells of the back gathers only held nodes, which covers the
-  // band the inflow copies (x < 2h ≤ 2 dx) at any particles per cell.
-  static constexpr double kInflowHoldCells = 3.0;
-  void start_moving();  // drive.start "moving": the settled glacier set in motion along its bed
+  double drive_speed_now() const { return settling_.active ? 0.0 : scene_.drive_velocity(time_); }
   // downstream_drive holds the nodes of this many cells upstream of the domain's end (the
   // outflow line is 3 cells from it, so 2 cells of ice before it move at the drive speed).
   static constexpr double kDownstreamDriveCells = 5.0;
-  // Vertical grid momentum in the downstream band (the held cells and one more).
-  double downstream_band_momentum_z() const;
-  void gather_velocity(std::size_t p, const StencilWeights<Dim>& w, const StencilOffsets<Dim>& d,
-                       std::size_t f0, double c_scale);
-  // ΔJ-bar volume averaging fused into the G2P sweeps (simulation.cpp explains it): gather v, C
-  // and scatter the weighted ΔJ in one coloured sweep; normalise per node; the update sweep
-  // interpolates ΔJ̄ back and updates the particle at once.
-  // Reads the grid's velocity, x, C, mass (softening_); writes v, C and grid_aux_'s sums.
-  void gather_velocities_and_scatter_volume();
-  // Reads grid_aux_'s sums and the nodes' intact_mass; writes grid_aux_'s averages.
-  void normalise_volume_average();
-  // numerics.average_per_cell, after normalise_volume_average: per cell the mean trial elastic
-  // volume. Reads grid_aux_, x, C, F_E (softening_); writes cell_aux_. With the relaxation it
-  // then puts the nodes' whole-volume average (grid_total_) in grid_aux_'s first slots, where
-  // the update sweep interpolates its target (volume_sums).
-  void average_over_cells();
-  struct VolumeSums {
-    double jbar, wsum, dj;
-  };
-  VolumeSums volume_sums(std::size_t p, const StencilWeights<Dim>& w) const;
-  Vec<2> stencil_sums(const StencilWeights<Dim>& w) const;
-  bool averaging_weights_damage() const;  // the averaging weights each particle by 1 − D
-  // A particle's weight in the ΔJ-bar average, m (1 − D) when it weights damage (then softening_
-  // holds 1 − D = e^{−ζ ε_v^p}, set by P2G), m otherwise: P2G adds it to the nodes' intact_mass
-  // and the gather sweep weights ΔJ by it.
-  double averaging_weight(std::size_t p, bool damage) const {
-    return particles_.mass[p] * (damage ? softening_[p] : 1.0);
-  }
-  // The grid cell holding grid coordinate xg (its lower corner node).
-  static IVec<Dim> cell_of(const Vec<Dim>& xg) {
-    IVec<Dim> c;
-    for (int a = 0; a < Dim; ++a) c[a] = static_cast<int>(std::floor(xg[a]));
-    return c;
-  }
-  double step_volume_ratio(std::size_t p) const {  // ΔJ = det(I + Δt C)
-    return (Mat<Dim>::Identity() + dt_ * particles_.C[p]).determinant();
-  }
-  // What particle p's volume is averaged as: ΔJ, or with numerics.average_total_volume its whole
-  // trial elastic volume ratio ΔJ·det F_E. The update scales ΔF by (averaged / this)^{1/d}.
-  // (With numerics.average_per_cell the stencil average takes ΔJ and the cell average the rest.)
-  double averaged_volume_ratio(std::size_t p) const {
-    const double dj = step_volume_ratio(p);
-    return scene_.average_total_volume ? dj * particles_.F_e[p].determinant() : dj;
-  }
+  // The ΔJ-bar average (average_) weights each particle by 1 − D (volume_average.hpp).
+  bool averaging_weights_damage() const;
   // G2P's update sweep: the particle update (engine/particle_update.hpp), the per-particle
-  // effects, the time step's summary. Average: after the ΔJ-bar sweeps; otherwise the velocity
-  // gather is fused into it. Reads the grid (velocity or grid_aux_), every particle array;
-  // writes x, v, C, F_E, τ, ε_v^p, summary_ and the clock (finish_step).
+  // effects, the time step's summary. Average: after the ΔJ-bar sweeps (average_); otherwise
+  // the velocity gather is fused into it. Reads the grid (velocity, or average_'s averages),
+  // every particle array; writes x, v, C, F_E, τ, ε_v^p, summary_ and the clock (finish_step).
   template <bool Plastic, bool Average>
   void update_particles();
   template <bool Plastic>
   void finish_step();
-  // Removes the particles past the outflow line. Reads x; compacts every particle array,
-  // writes removed_mass_ and the gate's archive.
+  // The outflow stage (outflow_). Reads x and summary_; compacts every particle array, writes
+  // outflow_'s removed mass and the gate's archive.
   void remove_outflow();
-  // Copies the band of ice that entered last one particle spacing upstream. Reads the clock,
-  // x; appends particles, writes inflow_mass_, inflow_columns_.
+  // The inflow stage (inflow_). Reads the clock, x; appends particles, writes inflow_.
   void inflow();
   // The next dt from the CFL condition, and the instability checks. Reads summary_ (or v, τ,
   // x); writes dt_, max_speed_, front_x_; throws SimulationError on an instability.
@@ -229,19 +185,13 @@ class Simulation {
   // stale once the outflow has removed particles.
   StepSummary summary_;
   std::int64_t summary_step_ = -1;
-  // P2G colouring: particle indices grouped by x-slab of kSlabCells cells, and the per-block
-  // slab counts of the parallel counting sort that builds it (reused every step).
-  std::vector<std::uint32_t> slab_order_;
-  std::vector<std::uint32_t> slab_start_;
-  std::vector<std::uint32_t> slab_block_offsets_;
-  // Volume averaging scratch (reused every step): per node (Σ w m (1−D) ΔJ, unused or with the
-  // relaxed per-cell average Σ w m (1−D) ΔJ J_E), then (averaged ΔJ, whether the node carries
-  // one); the weights Σ w m (1−D) are in the grid nodes.
-  std::vector<double> grid_aux_;
-  std::vector<double> grid_total_;  // average_relaxation_time: per node the stencil's whole volume
-  std::vector<double> cell_aux_;  // numerics.average_per_cell: per cell (by its corner node) the mean, has one
-  std::vector<double> softening_;  // per particle e^{−ζ ε_v^p} (plastic scenes), from P2G to the update
+  ParticleColouring<Dim> colouring_;  // the race-free order of P2G-style scatters
+  VolumeAverage<Dim> average_;         // numerics.volumetric_averaging
   std::vector<double> drive_node_mass_;  // per node: mass from the driven layer (drive_grid)
+  Outflow<Dim> outflow_;
+  Inflow<Dim> inflow_;
+  DownstreamImpulseMeter<Dim> downstream_;  // slab scenes
+  Settling settling_;
 
   Vec<Dim> domain_lo_, domain_hi_;
   double time_ = 0.0;
@@ -249,19 +199,11 @@ class Simulation {
   std::int64_t steps_ = 0;
   std::int64_t particle_steps_ = 0;
   std::int64_t return_map_evaluations_ = 0;
-  double removed_mass_ = 0.0;
-  double downstream_before_z_ = 0.0;
-  double downstream_impulse_z_ = 0.0;
-  double inflow_mass_ = 0.0;
-  std::int64_t inflow_columns_ = 0;  // columns seeded by the inflow so far
   // Largest physically possible particle speed [m/s] (slab scenes with gravity; 0 = none):
   // a faster particle means a numerical instability (update_time_step).
   double speed_bound_ = 0.0;
   double front_x_ = 0.0;
   double max_speed_ = 0.0;
-  bool settled_ = false;
-  bool settling_ = false;
-  double settle_damping_rate_ = 0.0;
 };
 
 extern template class Simulation<2>;

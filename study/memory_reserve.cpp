@@ -4,7 +4,6 @@
 
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
 #include <cstdlib>
 #include <mutex>
 #include <new>
@@ -13,13 +12,11 @@
 namespace crevasse {
 namespace {
 
+// Taken only by the new-handler and the functions below, never by an allocation that succeeds.
 std::mutex g_mutex;
-std::condition_variable g_handled;
 std::atomic<bool> g_armed{false};
 std::atomic<bool> g_ran_out{false};
-std::atomic<bool> g_gate{false};  // other threads wait while the thread that ran out unwinds
 // Guarded by g_mutex:
-std::thread::id g_holder;
 std::chrono::steady_clock::time_point g_ran_out_at;
 void* g_mapped = nullptr;
 std::size_t g_mapped_bytes = 0;
@@ -30,9 +27,10 @@ constexpr std::size_t kBlocks = 64;
 constexpr std::size_t kBlockBytes = 64u << 10;
 void* g_blocks[kBlocks] = {};
 
-// A wait is bounded: a failure handled where nobody calls rearm_memory_reserve(), or a thread
-// that ran out waiting for one that waits for it, only costs this long.
-constexpr auto kWaitLimit = std::chrono::seconds(2);
+// Another thread that runs out while the reserve is already given back retries for this long:
+// the case that took it fails at its next poll (twice a second) and frees its memory.
+constexpr auto kRetryLimit = std::chrono::seconds(2);
+constexpr auto kRetryPause = std::chrono::milliseconds(10);
 
 void take_reserve() {
   if (!g_mapped && g_mapped_bytes > 0) {
@@ -61,40 +59,21 @@ bool give_reserve_back() {
   return gave;
 }
 
-void wait_for_handling(std::unique_lock<std::mutex>& lock) {
-  if (!g_gate || g_holder == std::this_thread::get_id()) return;
-  if (!g_handled.wait_until(lock, g_ran_out_at + kWaitLimit, [] { return !g_gate.load(); }))
-    g_gate = false;  // not handled in time: stop holding the others up
-}
-
-// malloc failed: returns to have the allocation retried, or throws std::bad_alloc.
+// The new-handler ([new.handler]): operator new (every form) calls it when malloc fails and
+// retries when it returns. It frees room or throws std::bad_alloc.
 void on_allocation_failure() {
   std::unique_lock<std::mutex> lock(g_mutex);
-  if (g_gate && g_holder != std::this_thread::get_id()) {
-    wait_for_handling(lock);
-    return;
-  }
   if (give_reserve_back()) {
-    g_holder = std::this_thread::get_id();
     g_ran_out_at = std::chrono::steady_clock::now();
     g_ran_out = true;
-    g_gate = true;
+    return;
+  }
+  if (g_ran_out && std::chrono::steady_clock::now() - g_ran_out_at < kRetryLimit) {
+    lock.unlock();
+    std::this_thread::sleep_for(kRetryPause);
     return;
   }
   throw std::bad_alloc();
-}
-
-void* allocate(std::size_t n) {
-  if (n == 0) n = 1;
-  if (g_gate.load(std::memory_order_relaxed)) {
-    std::unique_lock<std::mutex> lock(g_mutex);
-    wait_for_handling(lock);
-  }
-  for (;;) {
-    if (void* p = std::malloc(n)) return p;
-    if (!g_armed.load(std::memory_order_relaxed)) throw std::bad_alloc();
-    on_allocation_failure();
-  }
 }
 
 }  // namespace
@@ -104,6 +83,7 @@ bool arm_memory_reserve(std::size_t bytes) {
   if (!g_armed) g_mapped_bytes = bytes > kBlocks * kBlockBytes ? bytes - kBlocks * kBlockBytes : 0;
   take_reserve();
   g_armed = true;
+  std::set_new_handler(on_allocation_failure);
   bool whole = g_mapped || g_mapped_bytes == 0;
   for (void* b : g_blocks) whole = whole && b;
   return whole;
@@ -126,16 +106,6 @@ void rearm_memory_reserve() {
   std::lock_guard<std::mutex> lock(g_mutex);
   take_reserve();
   g_ran_out = false;
-  g_gate = false;
-  g_holder = {};
-  g_handled.notify_all();
 }
 
 }  // namespace crevasse
-
-// The replaceable allocation functions ([new.delete.single], [new.delete.array]); libstdc++'s
-// nothrow forms call these, and operator delete stays the library's (std::free). They replace
-// the library's in every program that links this object (the runner references it). The
-// aligned forms (align_val_t) keep the library's: nothing here allocates over-aligned types.
-void* operator new(std::size_t n) { return crevasse::allocate(n); }
-void* operator new[](std::size_t n) { return crevasse::allocate(n); }

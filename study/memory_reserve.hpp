@@ -1,18 +1,18 @@
 #pragma once
 // Memory set aside for running out of it. A failed allocation inside a noexcept function
 // (nlohmann::json's destructor allocates) ends the process with SIGABRT whatever catches
-// std::bad_alloc further up, so the first failure does not throw: it gives the reserve back,
-// the allocation is retried and succeeds, and memory_ran_out() turns true. A case polls it
-// where throwing is safe and fails "out of memory"; the reserve is taken again once that
-// failure has been handled. Meanwhile the other threads' allocations wait (a few seconds at
-// most), so the room freed serves the thread that ran out. The program's operator new is
-// replaced for that: one relaxed atomic load per allocation while memory is plentiful.
+// std::bad_alloc further up, so the first failure does not throw: the program's new-handler
+// (std::set_new_handler) gives the reserve back, operator new retries and succeeds, and
+// memory_ran_out() turns true. A case polls it where throwing is safe and fails "out of
+// memory"; the reserve is taken again once that failure has been handled. Nothing runs on the
+// allocation path while memory is plentiful: the handler is called only when malloc fails.
 #include <cstddef>
 
 namespace crevasse {
 
 // Sets `bytes` aside for the whole process (address space and heap blocks whose pages are
-// never touched: no RAM). Returns false when not all of it could be had.
+// never touched: no RAM) and installs the new-handler. Returns false when not all of it could
+// be had.
 bool arm_memory_reserve(std::size_t bytes);
 
 // True from the failure that gave the reserve back until rearm_memory_reserve().
@@ -28,7 +28,7 @@ void throw_if_memory_ran_out();
 void top_up_memory_reserve();
 
 // Called where an out-of-memory failure has been handled and its owner's memory freed: takes
-// the reserve again and lets the waiting threads go on. Does nothing when none was armed.
+// the reserve again. Does nothing when none was armed.
 void rearm_memory_reserve();
 
 }  // namespace crevasse

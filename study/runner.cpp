@@ -4,6 +4,7 @@
 #include <tbb/task_arena.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <condition_variable>
 #include <deque>
 #include <exception>
@@ -18,6 +19,7 @@
 #include "engine/error.hpp"
 #include "study/engine_case.hpp"
 #include "study/eta.hpp"
+#include "study/memory_check.hpp"
 #include "study/memory_reserve.hpp"
 
 namespace crevasse {
@@ -234,8 +236,6 @@ class StudyRun {
     session.threads_per_case = report_.threads_per_case;
     session.shard = opt_.shard ? opt_.shard->text() : "";
     session.command = opt_.command;
-    store_.begin_session(session);
-    report_.session_id = session.session_id;
 
     const auto status = store_.statuses();
     for (const StudyCase* c : scope) {
@@ -247,11 +247,30 @@ class StudyRun {
       else
         todo_.push_back(c);
     }
+    if (!opt_.case_function) check_memory();  // before the session: the cases stay pending
+    store_.begin_session(session);
+    report_.session_id = session.session_id;
     progress_.total = scope.size();
     progress_.done = report_.already_done;
     progress_.failed = report_.already_failed;
     progress_.pending = todo_.size();
     if (opt_.observer) opt_.observer->on_start(report_, progress_);
+  }
+
+  // The largest cases to run, as many as run at once, must fit in the memory this process may
+  // still take: otherwise the study is refused before any case starts.
+  void check_memory() const {
+    std::vector<const SceneConfig*> largest;
+    for (const StudyCase* c : todo_) largest.push_back(&c->scene);
+    const std::size_t at_once = std::min<std::size_t>(largest.size(), static_cast<std::size_t>(report_.jobs));
+    std::partial_sort(largest.begin(), largest.begin() + static_cast<std::ptrdiff_t>(at_once), largest.end(),
+                      [](const SceneConfig* a, const SceneConfig* b) { return case_memory_bytes(*a) > case_memory_bytes(*b); });
+    largest.resize(at_once);
+    if (largest.empty()) return;
+    const auto it = std::find_if(todo_.begin(), todo_.end(), [&](const StudyCase* c) { return &c->scene == largest[0]; });
+    std::string what = "case " + (*it)->label;
+    if (at_once > 1) what += " with the next " + std::to_string(at_once - 1) + " largest at once";
+    check_memory_fits(largest, what, read_memory_headroom());
   }
 
   // One case, on a worker: runs it and hands its start and its end to the writer.

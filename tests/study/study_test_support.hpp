@@ -23,6 +23,14 @@ extern char** environ;
 
 namespace crevasse::test {
 
+// Built with AddressSanitizer or ThreadSanitizer, whose shadow memory does not fit under an
+// address-space limit (ulimit -v).
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+inline constexpr bool kSanitized = true;
+#else
+inline constexpr bool kSanitized = false;
+#endif
+
 // A fresh directory under the system temp dir, removed at the end of the test.
 class ScratchDir {
  public:

@@ -259,6 +259,7 @@ TEST(Reliability, LostOutputIsAnError) {
 // no case running (each is pending, failed with its reason, or done) and closes its session;
 // the same command without the limit then completes the study to the uninterrupted result.
 TEST(Reliability, OutOfMemoryIsOneLineAndLeavesTheStudyResumable) {
+  if (test::kSanitized) GTEST_SKIP() << "a sanitizer's shadow memory does not fit under ulimit -v";
   test::ScratchDir dir("rel_oom");
   test::write_text(dir / "s.json", test::tiny_study(2, 300, "oom").dump(2));
   ASSERT_EQ(run_cli(dir.path(), "study s.json --db ref.db --jobs 2 --quiet").code, 0);
@@ -288,6 +289,49 @@ TEST(Reliability, OutOfMemoryIsOneLineAndLeavesTheStudyResumable) {
     EXPECT_EQ(test::result_dump(dir / db), test::result_dump(dir / "ref.db")) << kib;
   }
   EXPECT_GT(ran_out, 0) << "no limit ran out of memory; lower the first one";
+}
+
+// A case that cannot fit is refused before any work: one line saying how much it needs and
+// which limit refuses it, exit 1, and its study database with every case pending and no session
+// open, to run the same command on a machine (or under a limit) where it fits. Refused here by
+// the machine (a case of 3e8 particles) and by the address-space limit (2e6 particles under
+// ulimit -v 1 GB); `crevasse run` refuses the same scene before it creates --out.
+TEST(Reliability, CaseLargerThanMemoryIsRefusedBeforeItStarts) {
+  if (test::kSanitized) GTEST_SKIP() << "a sanitizer's shadow memory does not fit under ulimit -v";
+  test::ScratchDir dir("rel_big");
+  const auto refused = [&](const std::string& name, double dx, const std::string& limit, const std::string& says) {
+    nlohmann::json study = test::tiny_study(2, 200, name);
+    study["base_scene"]["numerics"]["dx"] = dx;
+    test::write_text(dir / (name + ".json"), study.dump(2));
+    const std::string cmd = "cd '" + dir.path().string() + "' && bash -c \"" + limit + "exec '" CREVASSE_BINARY
+                            "' study " + name + ".json --db " + name + ".db --jobs 2 --quiet\" > /dev/null 2> err.txt";
+    const auto t0 = std::chrono::steady_clock::now();
+    const int status = std::system(cmd.c_str());
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const std::string err = read_file(dir / "err.txt");
+    ASSERT_TRUE(WIFEXITED(status)) << name;
+    EXPECT_EQ(WEXITSTATUS(status), 1) << name << ": " << err;
+    EXPECT_EQ(err.rfind("crevasse: error: case ", 0), 0u) << err;
+    EXPECT_NE(err.find("needs about"), std::string::npos) << err;
+    EXPECT_NE(err.find(says), std::string::npos) << err;
+    EXPECT_NE(err.find("--jobs"), std::string::npos) << err;  // two cases at once
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+    EXPECT_LT(seconds, 20.0) << name << ": the refusal came after work";
+    ASSERT_TRUE(fs::exists(dir / (name + ".db"))) << name;
+    EXPECT_EQ(one_value(dir / (name + ".db"), "SELECT group_concat(DISTINCT status) FROM cases"), "pending");
+    EXPECT_EQ(one_value(dir / (name + ".db"), "SELECT count(*) FROM sessions WHERE outcome IS NULL"), "0");
+  };
+  refused("machine", 0.01, "", "the machine has");
+  refused("ulimit", 0.25, "ulimit -v 1000000; ", "the address-space limit (ulimit -v) leaves");
+
+  nlohmann::json scene = test::tiny_scene();
+  scene["numerics"]["dx"] = 0.01;
+  test::write_text(dir / "big.json", scene.dump(2));
+  const test::CliResult r = run_cli(dir.path(), "run big.json --out out --quiet");
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_EQ(r.err.rfind("crevasse: error: the scene needs about", 0), 0u) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out"));
 }
 
 std::string bytes_of(const fs::path& p) {
