@@ -393,6 +393,17 @@ TEST(MeasureSkin, CracksUnderADamagedSkinAreCrevassesOfTheirOwnWhenAsked) {
   EXPECT_EQ(measure_crevasses(bare, under).crevasses.size(), measure_crevasses(bare).crevasses.size());
 }
 
+// The resolution floor c/(ρ_i g) ≥ 3 dx holds on the floor itself: a study that sets Π = 3 dx/H_i
+// (0.075 at H_i = 400 m) derives c = Π ρ_i g H_i, 1 ulp short of 30 m, and that case is resolved.
+TEST(MeasureResolution, TheFloorItselfIsResolved) {
+  const double rho = 917.0, g = 9.81, dx = 10.0;
+  for (const double h : {400.0, 600.0, 800.0}) {
+    const double pi_floor = 3.0 * dx / h;
+    EXPECT_FALSE(strength_under_resolved(pi_floor * rho * g * h, rho, g, dx)) << h;
+    EXPECT_TRUE(strength_under_resolved(0.99 * pi_floor * rho * g * h, rho, g, dx)) << h;
+  }
+}
+
 TEST(MeasureSlope, DepthIsRelativeToTheLocalSurfaceOnASlope) {
   // The surface drops 200 m over the slab (slope 0.1): a global surface height would be wrong
   // by up to 200 m.
