@@ -6,8 +6,24 @@
 
 namespace crevasse {
 
-Bed Bed::step(double x_top, double height, double length, double x_begin, double x_end) {
-  return Bed({{x_begin, height}, {x_top, height}, {x_top + length, 0.0}, {x_end, 0.0}});
+Bed Bed::step(double x_top, double height, double length, double x_begin, double x_end, double lip_radius) {
+  if (!(lip_radius > 0.0)) return Bed({{x_begin, height}, {x_top, height}, {x_top + length, 0.0}, {x_end, 0.0}});
+  // The ramp turns down by θ = atan(height/length); the arc's centre lies R below the plateau,
+  // t = R tan(θ/2) before the corner, and the arc runs from the plateau's tangent point to the
+  // ramp's, (x_top − t, height − R) + R (sin α, cos α) for α in [0, θ].
+  const double theta = std::atan2(height, length);
+  const double t = lip_radius * std::tan(0.5 * theta);
+  const double cx = x_top - t, cz = height - lip_radius;
+  std::vector<Point> v{{x_begin, height}};
+  constexpr int kSegments = 48;  // chord error R(1 − cos(θ/96)) < 1e-4·R
+  for (int i = 0; i <= kSegments; ++i) {
+    const double a = theta * i / kSegments;
+    v.push_back({cx + lip_radius * std::sin(a), cz + lip_radius * std::cos(a)});
+  }
+  if (length > 0.0) v.push_back({x_top + length, 0.0});
+  else v.push_back({x_top, 0.0});
+  v.push_back({x_end, 0.0});
+  return Bed(std::move(v));
 }
 
 Bed Bed::concave(double x_top, double height, double length, double x_begin, double x_end) {

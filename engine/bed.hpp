@@ -13,7 +13,10 @@ class Bed {
 
   // Plateau z = height for x ≤ x_top, straight ramp of horizontal length `length` down to the
   // floor z = 0 (length 0: vertical step), floor to x_end.
-  static Bed step(double x_top, double height, double length, double x_begin, double x_end);
+  // lip_radius > 0 rounds the convex corner at x_top with a circular arc of that radius, tangent
+  // to the plateau and the ramp (the caller keeps the arc's reach on both).
+  static Bed step(double x_top, double height, double length, double x_begin, double x_end,
+                  double lip_radius = 0.0);
   // Concave (trough-like) ramp: z_b = height·(1 − s)² with s = (x − x_top)/length, steep at the
   // top and flattening into the floor, as over a subglacial cauldron rim.
   static Bed concave(double x_top, double height, double length, double x_begin, double x_end);

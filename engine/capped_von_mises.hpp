@@ -31,6 +31,14 @@ struct CappedVonMisesParams {
   // is set by the engine each step; 0 = no creep (the rate-independent law).
   double creep_increment = 0.0;
   double creep_exponent = 3.0;
+  // Softening with a length (docs/model.md, "Softening with a length"). explicit_softening: the
+  // softening factor passed to the return mapping (from the nonlocal ε̂, nonlocal_opening.hpp)
+  // holds over the step, so the cap returns as perfectly plastic at c·e^{−ζ ε̂}.
+  // cap_relaxed_fraction: a Duvaut–Lions viscous cap (Needleman 1988, CMAME 67:69), the step
+  // takes the fraction (Δt/τ)/(1 + Δt/τ) of the inviscid return; set by the engine each step,
+  // 1 = rate-independent.
+  bool explicit_softening = false;
+  double cap_relaxed_fraction = 1.0;
 };
 
 // q at the end of one backward-Euler creep step from the trial q_t: the root of
@@ -136,7 +144,9 @@ inline ReturnResult<Dim> return_map_capped_von_mises(const Vec<Dim>& eps_trial, 
   const double tr = eps_trial.sum();
   const double p_trial = -k * tr;
   if (cap_violated(p_trial, p, softening)) {
-    const double delta = cap_return_increment(p_trial, k, eps_v_p, p);
+    const double inviscid = p.explicit_softening ? (-p.tensile_strength_c * softening - p_trial) / k
+                                                 : cap_return_increment(p_trial, k, eps_v_p, p);
+    const double delta = p.cap_relaxed_fraction * inviscid;
     r.eps.array() -= delta / Dim;
     r.delta_eps_v = delta;
     r.cap_active = true;
@@ -144,7 +154,7 @@ inline ReturnResult<Dim> return_map_capped_von_mises(const Vec<Dim>& eps_trial, 
   const double tr_new = r.eps.sum();
   Vec<Dim> dev = r.eps.array() - tr_new / Dim;
   const double q_trial = von_mises_of_strain_deviator(m, dev.norm());
-  const double q_y = r.cap_active ? shear_strength(p, eps_v_p + r.delta_eps_v, -k * tr_new)
+  const double q_y = r.cap_active && !p.explicit_softening ? shear_strength(p, eps_v_p + r.delta_eps_v, -k * tr_new)
                                   : shear_strength_softened(p, softening, -k * tr_new);
   const double q_end = p.creep_increment > 0.0
                            ? std::min(q_y, creep_relaxed(q_trial, 3.0 * m.mu * p.creep_increment, p.creep_exponent))

@@ -288,6 +288,12 @@ const std::vector<FieldSpec>& field_table() {
                    "derived"),
       boolean_field("ice.softening", "damage_softens_shear", P, &S::damage_softens_shear),
       number_field("ice.softening", "residual_friction", P, "–", &S::residual_friction, So, 0, 10),
+      written_when(number_field("ice.softening", "nonlocal_radius", P, "m", &S::nonlocal_radius, So, 0, 1e5),
+                   [](const S& s) { return s.nonlocal_radius > 0.0; }),
+      written_when(number_field("ice.softening", "nonlocal_weight", P, "–", &S::nonlocal_weight, So, 1, 4),
+                   [](const S& s) { return s.nonlocal_radius > 0.0; }),
+      written_when(number_field("ice.softening", "cap_relaxation_time", P, "s", &S::cap_relaxation_time, So, 0, 1e6),
+                   [](const S& s) { return s.cap_relaxation_time > 0.0; }),
       written_when(number_field("ice.creep", "rate_factor", P, "Pa⁻ⁿ/s", &S::creep_rate_factor, A, 0, 1), creeping),
       written_when(number_field("ice.creep", "exponent", P, "–", &S::creep_exponent, Cr, 1, 6), creeping),
       written_when(number_field("ice.creep", "field_speed", P, "m/s", &S::creep_field_speed, Cr, 0, 1e3, true),
@@ -295,6 +301,8 @@ const std::vector<FieldSpec>& field_table() {
       kind_field("bed", "shape", P, &S::bed_shape),
       number_field("bed", "step_height", P, "m", &S::step_height, Sl, 0, 1e5),
       number_field("bed", "step_length", P, "m", &S::step_length, Sl, 0, 1e6),
+      written_when(number_field("bed", "lip_radius", P, "m", &S::lip_radius, Sl, 0, 1e6),
+                   [](const S& s) { return s.lip_radius > 0.0; }),
       number_field("bed", "downstream_length", P, "m", &S::downstream_length, X, 0, 0, false, false, "10 H_i"),
       number_field("bed", "friction", P, "–", &S::bed_friction, A, 0, 10),
       number_field("bed", "z", P, "m", &S::flat_bed_z, X, 0, 0),
@@ -403,6 +411,10 @@ double SceneConfig::creep_rate() const {
   return speed_up * (2.0 / std::sqrt(3.0)) * creep_rate_factor * std::pow(3.0, -0.5 * creep_exponent);
 }
 
+double SceneConfig::lip_tangent() const {
+  return lip_radius * std::tan(0.5 * std::atan2(step_height, step_length));
+}
+
 double SceneConfig::implied_fracture_energy() const {
   return softening_zeta > 0 ? tensile_strength * dx / softening_zeta : 0.0;
 }
@@ -422,6 +434,12 @@ void SceneConfig::resolve() {
     fail("run", "give end_time, front_past_step, gate_length or max_steps, or the run never stops");
   if (has(Effect::softening) && !has(Effect::plasticity))
     fail("effects", "'softening' needs 'plasticity'");
+  if (nonlocal_radius > 0.0 && !has(Effect::softening))
+    fail("ice.softening.nonlocal_radius", "needs the 'softening' effect (it averages what softens)");
+  if (nonlocal_radius > 0.0 && nonlocal_radius < dx)
+    fail("ice.softening.nonlocal_radius", "value " + fmt(nonlocal_radius) + " m is below dx; allowed 0 or [dx, 1e5] m");
+  if (cap_relaxation_time > 0.0 && !has(Effect::plasticity))
+    fail("ice.softening.cap_relaxation_time", "needs the 'plasticity' effect");
   if (average_total_volume && !volumetric_averaging)
     fail("numerics.average_total_volume", "needs numerics.volumetric_averaging true (it says what the average takes)");
   if (average_relaxation_time > 0.0 && !average_per_cell)
@@ -482,6 +500,15 @@ void SceneConfig::resolve() {
       fail("bed.shape", std::string("value '") + kind_name(bed_shape) + "' is not 'step' or 'concave' (body 'slab')");
     if (bed_shape == BedShape::concave && step_length <= 0)
       fail("bed.step_length", "must be > 0 for the concave bed");
+    if (lip_radius > 0.0) {
+      if (bed_shape != BedShape::step) fail("bed.lip_radius", "rounds the lip of bed.shape 'step' only");
+      // The arc's tangent points lie lip_tangent() from the corner, on the plateau and the ramp.
+      const double room = std::min(upstream_length, std::hypot(step_height, step_length));
+      if (lip_tangent() > room)
+        fail("bed.lip_radius", "value " + fmt(lip_radius) + " m rounds the lip over " + fmt(lip_tangent()) +
+                                   " m each side, more than the " + fmt(room) + " m of plateau or ramp; allowed (0, " +
+                                   fmt(room / std::tan(0.5 * std::atan2(step_height, step_length))) + "] m");
+    }
     const double x_end = upstream_length + step_length + downstream_length;
     domain_min = {-4.0 * dx, 0.0, -4.0 * dx};
     domain_max = {x_end, width, step_height + ice_thickness + top_margin};

@@ -76,6 +76,12 @@ struct ScenePhysics {
   double fracture_energy = 0.0;       // G [J/m²]; 0 = derived from zeta_ref
   bool damage_softens_shear = true;   // q_y·exp(−ζ ε_v^p) (see capped_von_mises.hpp)
   double residual_friction = 1.2;     // M: damaged ice keeps q ≤ M·p (rubble, φ ≈ 30°)
+  // Softening with a length (docs/model.md): the opening the softening reads averaged over a
+  // radius R (engine/nonlocal_opening.hpp), with the over-nonlocal weight m; 0 = local.
+  double nonlocal_radius = 0.0;       // R [m]
+  double nonlocal_weight = 1.0;       // m [-]
+  // A viscous (Duvaut–Lions) cap: the opening relaxes onto the cap in τ [s]; 0 = rate-independent.
+  double cap_relaxation_time = 0.0;
   // Creep by Glen's law (docs/model.md, "Creep"), off while the rate factor is 0. The drive's
   // time is the field's sped up by drive.speed / creep_field_speed, so the creep rate is too.
   double creep_rate_factor = 0.0;     // A [Pa^-n s^-1] of the real ice; 0 = no creep
@@ -99,6 +105,7 @@ struct ScenePhysics {
   BedShape bed_shape = BedShape::step;
   double step_height = 100.0;         // H_s [m]
   double step_length = 100.0;         // L_s [m]; 0 = vertical step
+  double lip_radius = 0.0;            // the step's convex lip rounded over this radius [m]; 0 = sharp
   double downstream_length = 0.0;     // floor length past the step [m]; 0 → 10·H_i
   double bed_friction = 0.1;          // μ_b [-]
   double flat_bed_z = 0.0;            // bed flat: its height [m]
@@ -188,6 +195,8 @@ struct SceneConfig : ScenePhysics, SceneNumerics, SceneRun, SceneOutput {
   double drive_velocity(double t) const;  // piston speed at time t [m/s]
   double drive_position(double t) const;  // piston face x at time t (0 at t = 0) [m]
   double implied_fracture_energy() const;  // G = c·dx/ζ [J/m²] (band width h = dx)
+  // How far the rounded lip's arc reaches from the corner along the plateau and the ramp [m].
+  double lip_tangent() const;
   // Particles seeded at the start: the ice box, or the slab, over the particle spacing.
   double expected_particles() const;
   // Equivalent plastic strain rate per q^n in simulated time: (2/√3)·A·(q/√3)^n, Glen's law in

@@ -49,13 +49,17 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   plastic_.residual_friction_m = scene_.residual_friction;
   plastic_.creep_exponent = scene_.creep_exponent;
   creep_rate_ = scene_.has(Effect::plasticity) ? scene_.creep_rate() : 0.0;
+  if (scene_.has(Effect::softening) && scene_.nonlocal_radius > 0.0) {
+    nonlocal_ = NonlocalOpening<Dim>(scene_.nonlocal_radius, scene_.nonlocal_weight, scene_.dx);
+    plastic_.explicit_softening = true;
+  }
   grid_.dx = scene_.dx;
   domain_lo_ = to_vec<Dim>(scene_.domain_min);
   domain_hi_ = to_vec<Dim>(scene_.domain_max);
 
   const double x_lo = scene_.domain_min[0], x_hi = scene_.domain_max[0];
   if (scene_.bed_shape == BedShape::step) {
-    bed_ = Bed::step(scene_.step_top_x(), scene_.step_height, scene_.step_length, x_lo, x_hi);
+    bed_ = Bed::step(scene_.step_top_x(), scene_.step_height, scene_.step_length, x_lo, x_hi, scene_.lip_radius);
   } else if (scene_.bed_shape == BedShape::concave) {
     bed_ = Bed::concave(scene_.step_top_x(), scene_.step_height, scene_.step_length, x_lo, x_hi);
   } else if (scene_.bed_shape == BedShape::flat) {
@@ -85,6 +89,11 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   gravity[up_axis<Dim>] = -g * std::cos(tilt);
 
   add_stage("prepare_grid", [this] { prepare_grid(); });
+  // Before P2G, which keeps each particle's softening factor for the update.
+  if (nonlocal_.active() && scene_.has(Effect::plasticity))
+    add_stage("nonlocal_opening", [this] {
+      if (!settling_.active) nonlocal_.compute(particles_, grid_, colouring_);
+    });
   add_stage("p2g", [this] { particle_to_grid(); });
   add_stage(g != 0.0 ? "grid_velocity_gravity" : "grid_velocity",
             [this, gravity] { grid_velocity(gravity); });
@@ -311,7 +320,7 @@ void Simulation<Dim>::scatter_to_grid() {
     const Vec<Dim> mv = m * P.v[p];
     double wm = 0.0;
     if constexpr (Average) {
-      const double f = plastic ? softening_factor(plastic_, P.eps_v_p[p]) : 1.0;
+      const double f = plastic ? softening_factor(plastic_, opening_for_softening(p)) : 1.0;
       if (plastic) average_.keep_softening(p, f);
       wm = average_.weight(P, p, damage);
     }
@@ -365,6 +374,10 @@ void Simulation<Dim>::update_particles() {
   const bool kept_softening = average_.kept_softening();  // P2G kept e^{−ζ ε_v^p} (averaged, plastic)
   const ParticleEffects<Dim> effects = particle_effects_now();
   plastic_.creep_increment = dt_ * creep_rate_;
+  if (scene_.cap_relaxation_time > 0.0) {
+    const double r = dt_ / scene_.cap_relaxation_time;
+    plastic_.cap_relaxed_fraction = r / (1.0 + r);
+  }
   // What the update needs of particle p first: with the average, its stencil's sums (its velocity
   // was gathered by average_.gather_and_scatter); without, the gather itself.
   const auto inputs = [&](std::size_t p, double& jbar, double& wsum, double& dj,
@@ -379,7 +392,7 @@ void Simulation<Dim>::update_particles() {
       soft = kept_softening ? average_.softening(p) : 1.0;
     } else {
       gather_velocity(P, grid_, p, w, StencilOffsets<Dim>(w, xg, dx), grid_.flat(w.base()), c_scale);
-      soft = Plastic ? softening_factor(plastic_, P.eps_v_p[p]) : 1.0;
+      soft = Plastic ? softening_factor(plastic_, opening_for_softening(p)) : 1.0;
     }
   };
   summary_ = tbb::parallel_reduce(

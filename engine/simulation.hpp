@@ -21,6 +21,7 @@
 #include "engine/grid.hpp"
 #include "engine/hencky.hpp"
 #include "engine/inflow.hpp"
+#include "engine/nonlocal_opening.hpp"
 #include "engine/outflow.hpp"
 #include "engine/particle_colouring.hpp"
 #include "engine/particle_effects.hpp"
@@ -166,6 +167,12 @@ class Simulation {
   // x); writes dt_, max_speed_, front_x_; throws SimulationError on an instability.
   void update_time_step();
 
+  // What particle p's softening reads: its own ε_v^p, or the nonlocal ε̂ (nonlocal_), which
+  // stays 0 while settling (no opening yet).
+  double opening_for_softening(std::size_t p) const {
+    return nonlocal_.active() && !settling_.active ? nonlocal_.at(p) : particles_.eps_v_p[p];
+  }
+
   SceneConfig scene_;
   ElasticModuli moduli_;
   CappedVonMisesParams plastic_;
@@ -187,6 +194,7 @@ class Simulation {
   std::int64_t summary_step_ = -1;
   ParticleColouring<Dim> colouring_;  // the race-free order of P2G-style scatters
   VolumeAverage<Dim> average_;         // numerics.volumetric_averaging
+  NonlocalOpening<Dim> nonlocal_;      // ice.softening.nonlocal_radius
   std::vector<double> drive_node_mass_;  // per node: mass from the driven layer (drive_grid)
   Outflow<Dim> outflow_;
   Inflow<Dim> inflow_;

@@ -277,7 +277,7 @@ class StudyRun {
   void run_case(std::size_t slot) {
     const StudyCase& c = *todo_[slot];
     const int threads = report_.threads_per_case;
-    Event started{Event::Kind::started, slot, {}, utc_now_iso8601()};
+    Event started{Event::Kind::started, slot, {}, utc_now_iso8601(), {}};
     const std::string started_at = started.started_at;
     queue_.push(std::move(started));
     if (exact_peak_rss_) reset_peak_rss();
@@ -318,7 +318,7 @@ class StudyRun {
     // that arrives after the limit has passed is still a stop, and the case stays pending.
     if (failure.empty() && outcome.cancelled) {
       if (!outcome.out_of_time) {
-        queue_.push(Event{Event::Kind::cancelled, slot, {}, started_at});
+        queue_.push(Event{Event::Kind::cancelled, slot, {}, started_at, {}});
         return;
       }
       out_of_time = true;
@@ -359,7 +359,7 @@ class StudyRun {
       r.result_json = {{"status", "failed"}};
       if (opt_.fail_fast) stop().store(true);
     }
-    queue_.push(Event{Event::Kind::finished, slot, std::move(r), started_at});
+    queue_.push(Event{Event::Kind::finished, slot, std::move(r), started_at, {}});
   }
 
   // The writer loop: stores what the workers hand over and reports progress, until the workers

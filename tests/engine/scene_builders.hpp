@@ -104,6 +104,29 @@ inline SceneConfig small_glacier_scene(const SmallGlacier& g) {
   return s;
 }
 
+// A bar of ice (plane strain, length × thickness, free faces, no gravity) held by two rigid grips
+// `grip` long that move apart at ±speed (velocity_boundaries), c = 1 MPa, q_y = 10 MPa, ζ from
+// the crack-band reference ζ = 500·dx/(1 m). Not yet resolved: the caller sets what it varies
+// and calls finish().
+inline SceneConfig pulled_bar_scene(double length, double thickness, double grip, double speed, double dx) {
+  SceneConfig s = box_scene(2, {0, 0, 0}, {length, thickness, 0}, {-4, -2, 0}, {length + 4, thickness + 2, 0},
+                            {Effect::plasticity, Effect::softening, Effect::velocity_boundaries}, dx);
+  s.tensile_strength = 1.0e6;
+  s.shear_strength = 1.0e7;
+  s.zeta_ref = 500.0;
+  s.dx_ref = 1.0;
+  s.softening_zeta = 0.0;
+  VelocityBox left, right;
+  left.min = {-10, -10, 0};
+  left.max = {grip, 10, 0};
+  left.velocity = {-speed, 0, 0};
+  right.min = {length - grip, -10, 0};
+  right.max = {length + 10, 10, 0};
+  right.velocity = {speed, 0, 0};
+  s.velocity_boxes = {left, right};
+  return s;
+}
+
 inline SceneConfig finish(SceneConfig s) {
   s.resolve();
   return s;

@@ -23,7 +23,6 @@
 namespace crevasse {
 namespace {
 
-using test::box_scene;
 using test::finish;
 
 constexpr double kLength = 10.0;    // bar length [m]
@@ -39,24 +38,9 @@ struct BarResult {
 };
 
 BarResult pull_bar_apart(double dx, double t_end) {
-  SceneConfig s = box_scene(
-      2, {0, 0, 0}, {kLength, kThickness, 0}, {-4, -2, 0}, {kLength + 4, kThickness + 2, 0},
-      {Effect::plasticity, Effect::softening, Effect::velocity_boundaries}, dx);
-  s.tensile_strength = 1.0e6;
-  s.shear_strength = 1.0e7;
   // ζ = 500 at dx = 1 m: full opening (ζ ε_v^p ≈ 5) needs a few cm, so the test is short;
   // ζ stays below K/c ≈ 960 at every dx (implicit cap).
-  s.zeta_ref = 500.0;
-  s.dx_ref = 1.0;
-  s.softening_zeta = 0.0;
-  VelocityBox left, right;
-  left.min = {-10, -10, 0};
-  left.max = {kGrip, 10, 0};
-  left.velocity = {-kPullSpeed, 0, 0};
-  right.min = {kLength - kGrip, -10, 0};
-  right.max = {kLength + 10, 10, 0};
-  right.velocity = {kPullSpeed, 0, 0};
-  s.velocity_boxes = {left, right};
+  SceneConfig s = test::pulled_bar_scene(kLength, kThickness, kGrip, kPullSpeed, dx);
   s = finish(s);
   EXPECT_DOUBLE_EQ(s.softening_zeta, 500.0 * dx);  // crack-band scaling ζ ∝ dx
 

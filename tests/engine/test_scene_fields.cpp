@@ -91,11 +91,15 @@ TEST(SceneFields, EachKeyReachesItsOwnMember) {
       {"ice.softening.zeta_ref", [](const SceneConfig& s) { return s.zeta_ref; }},
       {"ice.softening.dx_ref", [](const SceneConfig& s) { return s.dx_ref; }},
       {"ice.softening.residual_friction", [](const SceneConfig& s) { return s.residual_friction; }},
+      {"ice.softening.nonlocal_radius", [](const SceneConfig& s) { return s.nonlocal_radius; }},
+      {"ice.softening.nonlocal_weight", [](const SceneConfig& s) { return s.nonlocal_weight; }},
+      {"ice.softening.cap_relaxation_time", [](const SceneConfig& s) { return s.cap_relaxation_time; }},
       {"ice.creep.rate_factor", [](const SceneConfig& s) { return s.creep_rate_factor; }},
       {"ice.creep.exponent", [](const SceneConfig& s) { return s.creep_exponent; }},
       {"ice.creep.field_speed", [](const SceneConfig& s) { return s.creep_field_speed; }},
       {"bed.step_height", [](const SceneConfig& s) { return s.step_height; }},
       {"bed.step_length", [](const SceneConfig& s) { return s.step_length; }},
+      {"bed.lip_radius", [](const SceneConfig& s) { return s.lip_radius; }},
       {"bed.downstream_length", [](const SceneConfig& s) { return s.downstream_length; }},
       {"bed.friction", [](const SceneConfig& s) { return s.bed_friction; }},
       {"drive.speed", [](const SceneConfig& s) { return s.drive_speed; }},
@@ -134,6 +138,15 @@ TEST(SceneFields, EachKeyReachesItsOwnMember) {
   j["ice"]["creep"] = {{"rate_factor", 2.4e-24}, {"exponent", 3.0}, {"field_speed", 3.17e-6}};
   j["numerics"]["average_per_cell"] = true;  // written only when set, like the creep section
   j["numerics"]["average_relaxation_time"] = 0.05;
+  // Nor the softening's length, its viscous cap or a rounded lip when they are off.
+  EXPECT_FALSE(j["ice"]["softening"].contains("nonlocal_radius"));
+  EXPECT_FALSE(j["ice"]["softening"].contains("nonlocal_weight"));
+  EXPECT_FALSE(j["ice"]["softening"].contains("cap_relaxation_time"));
+  EXPECT_FALSE(j["bed"].contains("lip_radius"));
+  j["ice"]["softening"]["nonlocal_radius"] = 30.0;
+  j["ice"]["softening"]["nonlocal_weight"] = 1.5;
+  j["ice"]["softening"]["cap_relaxation_time"] = 0.1;
+  j["bed"]["lip_radius"] = 20.0;
   const auto pointer = [](std::string path) {
     for (char& c : path)
       if (c == '.') c = '/';
