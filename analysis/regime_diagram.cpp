@@ -12,6 +12,8 @@ namespace {
 const Color kFitLine{0.1, 0.1, 0.1, 1.0};
 const Color kFitBand{0.35, 0.35, 0.35, 0.22};
 const Color kBreakBand{0.902, 0.624, 0.0, 0.22};  // Okabe–Ito orange, light
+const Color kUnderResolvedBand{0.5, 0.5, 0.5, 0.10};  // overlapping floors darken
+const Color kReferenceLine{0.0, 0.447, 0.698, 0.9};   // Okabe–Ito blue
 const Color kFailed{0.35, 0.35, 0.35, 1.0};
 
 std::string fixed(double value, int decimals) {
@@ -176,9 +178,10 @@ Figure regime_diagram(const std::vector<RegimePoint>& points, const RegimeFit& f
     if (p.failed && std::find(reasons.begin(), reasons.end(), p.missing_reason) == reasons.end())
       reasons.push_back(p.missing_reason);
   }
-  const std::size_t fit_entries = std::holds_alternative<BrokenLineFit>(fit)  ? 4
-                                  : std::holds_alternative<PowerLawFit>(fit) ? 2
-                                                                             : 0;
+  const std::size_t fit_entries = (std::holds_alternative<BrokenLineFit>(fit)  ? 4
+                                   : std::holds_alternative<PowerLawFit>(fit) ? 2
+                                                                              : 0) +
+                                  options.references.size() + (options.shade_below.empty() ? 0 : 1);
   RegimeDiagramOptions layout = options;
   if (options.legend == LegendPosition::upper_left &&
       groups.size() + reasons.size() + fit_entries > 7) {
@@ -199,6 +202,19 @@ Figure regime_diagram(const std::vector<RegimePoint>& points, const RegimeFit& f
                                   "value as failed, and check Π > 0");
     }
   }
+
+  if (!options.shade_below.empty()) {
+    double x_min = HUGE_VAL;
+    for (const RegimePoint& p : points) x_min = std::min(x_min, p.pi);
+    bool named = false;
+    for (double x : options.shade_below) {
+      if (!(x > x_min)) continue;
+      figure.add_vertical_band(x_min, x, kUnderResolvedBand, named ? "" : options.shade_legend);
+      named = true;
+    }
+  }
+  for (const ReferenceCurve& r : options.references)
+    figure.add_line(r.x, r.y, {kReferenceLine, 1.2, {5.0, 3.0}}, r.legend);
 
   std::vector<std::string> annotations;
   if (const auto* power = std::get_if<PowerLawFit>(&fit)) {

@@ -32,8 +32,19 @@ struct RegimePoint {
 // No fit, one power law, or a broken line.
 using RegimeFit = std::variant<std::monostate, PowerLawFit, BrokenLineFit>;
 
+// A curve drawn dashed under the data, with its legend (e.g. Nye's zero-stress depth).
+struct ReferenceCurve {
+  std::string legend;
+  std::vector<double> x, y;
+};
+
 struct RegimeDiagramOptions {
   std::string title;
+  std::vector<ReferenceCurve> references;
+  // Each shaded lightly from the smallest x drawn up to it, so that overlaps darken (e.g. each
+  // H_i's resolution floor Π = 3 dx/H_i); one legend entry.
+  std::vector<double> shade_below;
+  std::string shade_legend = "under-resolved below (c/(ρ_i g) < 3 dx), per H_i";
   std::string x_label = "Π = c/(ρ_i g H_i)";
   std::string y_label = "L_p/H_i";
   std::string x_symbol = "Π";  // used in the exponent and breakpoint text

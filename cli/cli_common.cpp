@@ -45,6 +45,10 @@ void check_output_directory(const std::string& option, const fs::path& dir,
     throw InputError(option + ": cannot write in " + existing.string() + " (" + std::strerror(errno) + ")");
   ::close(fd);
   ::unlink(probe.c_str());
+  // A command killed between its probe's mkstemp and unlink leaves the probe behind: clear such
+  // leftovers (another command's live probe, if any, only loses a file it is about to unlink).
+  for (const auto& e : fs::directory_iterator(existing, ec))
+    if (e.path().filename().string().rfind(".crevasse-probe-", 0) == 0) fs::remove(e.path(), ec);
   for (const std::string& name : files) {  // a name ending in '/' is a folder
     const fs::path p = dir / name;
     if (!fs::exists(fs::symlink_status(p, ec))) continue;

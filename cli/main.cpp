@@ -146,8 +146,8 @@ int run_command_line(int argc, char** argv) {
   plot->add_option("--model", plot_opt.model, "Fit drawn: auto (broken line when warranted), single, broken, none");
   plot->add_option("--fixed-exponents", plot_opt.fixed_exponents, "As crevasse fit (default: what the fits table used)");
   plot->add_option("--fixed-depth-exponents", plot_opt.fixed_depth_exponents, "As crevasse fit");
-  plot->add_option("--cdf-cases", plot_opt.cdf_cases, "Case indexes for the spacing CDFs (default: up to 4 spread over the group)")->delimiter(',');
-  plot->add_option("--cdf-normalise", plot_opt.cdf_normalise, "Spacing CDFs normalised by: median (of each case), thickness, none");
+  plot->add_option("--cdf-cases", plot_opt.cdf_cases, "Case indexes for the spacing and depth CDFs (default: up to 4 spread over the group)")->delimiter(',');
+  plot->add_option("--cdf-normalise", plot_opt.cdf_normalise, "Spacing CDFs normalised by: median (of each case), thickness (H_i), bending (sqrt(c H_i/(rho_i g))), strength (c/(rho_i g)), none; the depth CDFs of the same cases are over H_i");
   plot->add_option("--add-cases", plot_opt.add_cases, "Other study databases whose cases are drawn too, not fitted (e.g. 3D cases on the 2D diagram)")->delimiter(',');
   plot->add_flag("--include-under-resolved", plot_opt.include_under_resolved, "Fit and draw under_resolved cases (c/(rho_i g) < 3 dx) like the others; by default they are drawn hollow and not fitted");
   plot->add_flag("--exclude-fragmented", plot_opt.exclude_fragmented, "Leave fragmented cases out of the drawn fit, marked on the bottom edge (default: as the fits table was made)");

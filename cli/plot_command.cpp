@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <set>
 
 #include "analysis/regime_diagram.hpp"
 #include "cli/cli_common.hpp"
@@ -77,6 +78,38 @@ std::vector<const CaseRecord*> default_cdf_cases(const std::vector<CaseRecord>& 
   return chosen;
 }
 
+// Against Π: each H_i's resolution floor Π = 3 dx/H_i shaded, and on the depth diagram Nye's
+// zero-stress depth D = 2c/(ρ_i g), D/H_i = 2Π up to the bed (docs/fits.md, "Nye's depth").
+void add_references(analysis::RegimeDiagramOptions& options, Quantity q,
+                    const std::vector<std::pair<const CaseRecord*, std::string>>& cases,
+                    const std::vector<analysis::RegimePoint>& points) {
+  std::set<double> floors;
+  for (const auto& [c, prefix] : cases)
+    if (c->dx_m > 0.0 && c->thickness_m() > 0.0) floors.insert(3.0 * c->dx_m / c->thickness_m());
+  options.shade_below.assign(floors.begin(), floors.end());
+  if (q != Quantity::depth) return;
+  double lo = HUGE_VAL, hi = 0.0;
+  for (const analysis::RegimePoint& p : points) {
+    lo = std::min(lo, p.pi);
+    hi = std::max(hi, p.pi);
+  }
+  analysis::ReferenceCurve nye{"Nye's zero-stress depth, D_p/H_i = 2Π", {}, {}};
+  constexpr int kPoints = 64;
+  for (int i = 0; i <= kPoints && hi > 0.0; ++i) {
+    const double x = lo * std::pow(hi / lo, static_cast<double>(i) / kPoints);
+    nye.x.push_back(x);
+    nye.y.push_back(std::min(1.0, 2.0 * x));
+  }
+  options.references.push_back(std::move(nye));
+}
+
+// The median of a non-empty sample.
+double median_of(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
 }  // namespace
 
 std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
@@ -85,10 +118,10 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
   const FitGroup& colour_by = find_fit_group(opt.colour_by, "--colour-by");
   if (opt.model != "auto" && opt.model != "single" && opt.model != "broken" && opt.model != "none")
     throw InputError("--model: '" + opt.model + "' is not one of auto, single, broken, none");
-  if (opt.cdf_normalise != "median" && opt.cdf_normalise != "thickness" &&
-      opt.cdf_normalise != "none")
+  if (opt.cdf_normalise != "median" && opt.cdf_normalise != "thickness" && opt.cdf_normalise != "bending" &&
+      opt.cdf_normalise != "strength" && opt.cdf_normalise != "none")
     throw InputError("--cdf-normalise: '" + opt.cdf_normalise +
-                     "' is not one of median, thickness, none");
+                     "' is not one of median, thickness, bending, strength, none");
 
   Store store = Store::open_reader(opt.db_path);
   const std::vector<CaseRecord> cases = read_case_records(store);
@@ -195,6 +228,7 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
     options.y_label = quantity_symbol(q);
     options.x_label = group.axis_label;
     options.x_symbol = group.symbol;
+    if (std::string(group.name) == "cohesion_ratio") add_references(options, q, drawn_cases, points);
     const analysis::Figure figure = analysis::regime_diagram(points, drawn, options);
     const std::string stem =
         std::string(q == Quantity::spacing ? "spacing" : "depth") + "_vs_" + group.name;
@@ -227,14 +261,13 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
                        ? ""
                        : ", " + group_value_label(kFitGroups[1], c->group(kFitGroups[1])));
     std::vector<double> v = c->spacings_m;
+    // c/(ρ_i g) = Π H_i: the strength scale; sqrt(c H_i/(ρ_i g)) = H_i sqrt(Π): the bending one.
+    const double h = c->thickness_m(), pi = c->cohesion_ratio();
     double scale = 1.0;
-    if (opt.cdf_normalise == "thickness") scale = c->thickness_m();
-    if (opt.cdf_normalise == "median") {
-      std::vector<double> sorted = v;
-      std::sort(sorted.begin(), sorted.end());
-      const std::size_t n = sorted.size();
-      scale = n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
-    }
+    if (opt.cdf_normalise == "thickness") scale = h;
+    if (opt.cdf_normalise == "bending") scale = h * std::sqrt(pi);
+    if (opt.cdf_normalise == "strength") scale = pi * h;
+    if (opt.cdf_normalise == "median") scale = median_of(v);
     for (double& x : v) x /= scale;
     sample.values = std::move(v);
     samples.push_back(std::move(sample));
@@ -243,6 +276,8 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
   cdf.title = analysis::escape_markup(own_name) + ": crevasse spacings of " + std::to_string(samples.size()) + " case(s)";
   cdf.x_label = opt.cdf_normalise == "median"      ? "L_p / median L_p of the case"
                 : opt.cdf_normalise == "thickness" ? "L_p/H_i"
+                : opt.cdf_normalise == "bending"   ? "L_p / sqrt(c H_i/(ρ_i g))"
+                : opt.cdf_normalise == "strength"  ? "L_p / (c/(ρ_i g))"
                                                    : "L_p [m]";
   const auto files = write_png_and_svg(analysis::empirical_cdf_figure(samples, cdf),
                                        fs::path(opt.out_dir) / "spacing_cdf");
@@ -250,6 +285,23 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
   std::printf("%s: spacing CDFs of case(s)", files.front().c_str());
   for (const CaseRecord* c : cdf_cases) std::printf(" %lld", static_cast<long long>(c->case_index));
   std::printf(", normalised by %s\n", opt.cdf_normalise.c_str());
+
+  // The depths of the same cases, over H_i (the depth of every crevasse, a case with one counts).
+  std::vector<analysis::NamedSample> depths;
+  for (std::size_t i = 0; i < cdf_cases.size(); ++i) {
+    if (cdf_cases[i]->depths_m.empty()) continue;
+    analysis::NamedSample d{samples[i].name, cdf_cases[i]->depths_m};
+    for (double& x : d.values) x /= cdf_cases[i]->thickness_m();
+    depths.push_back(std::move(d));
+  }
+  if (depths.empty()) return written;
+  analysis::CdfFigureOptions depth_cdf;
+  depth_cdf.title = analysis::escape_markup(own_name) + ": crevasse depths of " + std::to_string(depths.size()) + " case(s)";
+  depth_cdf.x_label = "D_p/H_i";
+  const auto depth_files = write_png_and_svg(analysis::empirical_cdf_figure(depths, depth_cdf),
+                                             fs::path(opt.out_dir) / "depth_cdf");
+  written.insert(written.end(), depth_files.begin(), depth_files.end());
+  std::printf("%s: depth CDFs of the same case(s)\n", depth_files.front().c_str());
   return written;
 }
 

@@ -84,9 +84,10 @@ int status_command(const StatusCommandOptions& opt) {
   if (c.done > 0) {
     const long long limit = opt.all_cases ? -1 : kDefaultCaseRows;
     // deep = the damaged share of the window's ice more than H_i/2 below its surface
-    // (docs/measurement.md): shattering under an intact surface shows there.
-    std::printf("done:\n  %5s  %-10s %8s %8s %8s %7s  %5s %9s %9s %5s %8s  %s\n", "index", "case",
-                "H_i[m]", "Pi", "r=Ls/Hi", "S", "crev", "Lp/Hi", "Dp/Hi", "deep", "wall", "label");
+    // (docs/measurement.md): shattering under an intact surface shows there. >H/2 = the share of
+    // the crevasses deeper than H_i/2.
+    std::printf("done:\n  %5s  %-10s %8s %8s %8s %7s  %5s %9s %9s %5s %5s %8s  %s\n", "index", "case",
+                "H_i[m]", "Pi", "r=Ls/Hi", "S", "crev", "Lp/Hi", "Dp/Hi", ">H/2", "deep", "wall", "label");
     Statement s(
         db,
         "WITH c AS (SELECT *, json_extract(run_json, '$.measured_from') IS NOT NULL AS remeasured "
@@ -100,15 +101,18 @@ int status_command(const StatusCommandOptions& opt) {
         "m.fragmented, " +
             store.under_resolved_column() +
             ", 100.0 * json_extract(c.result_json, '$.measurement.damage.deep_damaged_fraction'), "
-            "c.remeasured FROM c LEFT JOIN summaries m USING (case_id) ORDER BY c.case_index LIMIT ?");
+            "c.remeasured, "
+            "(SELECT 100.0 * avg(d.value > c.thickness_m / 2) "
+            "FROM json_each(c.result_json, '$.measurement.depths_m') d) "
+            "FROM c LEFT JOIN summaries m USING (case_id) ORDER BY c.case_index LIMIT ?");
     s.bind(1, static_cast<std::int64_t>(limit));
     while (s.step()) {
-      std::printf("  %5lld  %-10s %8s %8s %8s %7s  %5lld %9s %9s %5s %8s  %s%s%s%s\n",
+      std::printf("  %5lld  %-10s %8s %8s %8s %7s  %5lld %9s %9s %5s %5s %8s  %s%s%s%s\n",
                   static_cast<long long>(s.integer(0)), s.text(1).c_str(),
                   cell(s, 2, "%.0f").c_str(), cell(s, 3, "%.4g").c_str(),
                   cell(s, 4, "%.3g").c_str(), cell(s, 5, "%.3g").c_str(),
                   static_cast<long long>(s.integer(6)), cell(s, 7, "%.3f").c_str(),
-                  cell(s, 8, "%.3f").c_str(), cell(s, 13, "%.0f%%").c_str(),
+                  cell(s, 8, "%.3f").c_str(), cell(s, 15, "%.0f%%").c_str(), cell(s, 13, "%.0f%%").c_str(),
                   format_wall_time(s.real(9)).c_str(),
                   s.text(10).c_str(),
                   s.integer(11) ? "  (fragmented)" : "",

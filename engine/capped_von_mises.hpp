@@ -39,6 +39,10 @@ struct CappedVonMisesParams {
   // 1 = rate-independent.
   bool explicit_softening = false;
   double cap_relaxed_fraction = 1.0;
+  // Brittle cap (the variant of the capped von Mises law in Blatny & Gaume's matter code): a
+  // state past the cap loses its whole elastic strain, F_E → the rotation, its trace going into
+  // ε_v^p; the opened ice carries no stress in that step, shear included.
+  bool brittle_cap = false;
 };
 
 // q at the end of one backward-Euler creep step from the trial q_t: the root of
@@ -143,6 +147,12 @@ inline ReturnResult<Dim> return_map_capped_von_mises(const Vec<Dim>& eps_trial, 
   const double k = m.bulk(Dim);
   const double tr = eps_trial.sum();
   const double p_trial = -k * tr;
+  if (p.brittle_cap && cap_violated(p_trial, p, softening)) {
+    r.eps.setZero();
+    r.delta_eps_v = tr;
+    r.cap_active = true;
+    return r;
+  }
   if (cap_violated(p_trial, p, softening)) {
     const double inviscid = p.explicit_softening ? (-p.tensile_strength_c * softening - p_trial) / k
                                                  : cap_return_increment(p_trial, k, eps_v_p, p);

@@ -294,6 +294,8 @@ const std::vector<FieldSpec>& field_table() {
                    [](const S& s) { return s.nonlocal_radius > 0.0; }),
       written_when(number_field("ice.softening", "cap_relaxation_time", P, "s", &S::cap_relaxation_time, So, 0, 1e6),
                    [](const S& s) { return s.cap_relaxation_time > 0.0; }),
+      written_when(boolean_field("ice.softening", "brittle_cap", P, &S::brittle_cap),
+                   [](const S& s) { return s.brittle_cap; }),
       written_when(number_field("ice.creep", "rate_factor", P, "Pa⁻ⁿ/s", &S::creep_rate_factor, A, 0, 1), creeping),
       written_when(number_field("ice.creep", "exponent", P, "–", &S::creep_exponent, Cr, 1, 6), creeping),
       written_when(number_field("ice.creep", "field_speed", P, "m/s", &S::creep_field_speed, Cr, 0, 1e3, true),
@@ -438,6 +440,8 @@ void SceneConfig::resolve() {
     fail("ice.softening.nonlocal_radius", "needs the 'softening' effect (it averages what softens)");
   if (nonlocal_radius > 0.0 && nonlocal_radius < dx)
     fail("ice.softening.nonlocal_radius", "value " + fmt(nonlocal_radius) + " m is below dx; allowed 0 or [dx, 1e5] m");
+  if (brittle_cap && (cap_relaxation_time > 0.0 || nonlocal_radius > 0.0))
+    fail("ice.softening.brittle_cap", "drops the stress at once: not with cap_relaxation_time or nonlocal_radius");
   if (cap_relaxation_time > 0.0 && !has(Effect::plasticity))
     fail("ice.softening.cap_relaxation_time", "needs the 'plasticity' effect");
   if (average_total_volume && !volumetric_averaging)

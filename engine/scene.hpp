@@ -82,6 +82,8 @@ struct ScenePhysics {
   double nonlocal_weight = 1.0;       // m [-]
   // A viscous (Duvaut–Lions) cap: the opening relaxes onto the cap in τ [s]; 0 = rate-independent.
   double cap_relaxation_time = 0.0;
+  // The brittle cap (capped_von_mises.hpp): past the cap the ice drops all its stress.
+  bool brittle_cap = false;
   // Creep by Glen's law (docs/model.md, "Creep"), off while the rate factor is 0. The drive's
   // time is the field's sped up by drive.speed / creep_field_speed, so the creep rate is too.
   double creep_rate_factor = 0.0;     // A [Pa^-n s^-1] of the real ice; 0 = no creep

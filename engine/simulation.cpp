@@ -49,6 +49,7 @@ Simulation<Dim>::Simulation(const SceneConfig& scene) : scene_(scene) {
   plastic_.residual_friction_m = scene_.residual_friction;
   plastic_.creep_exponent = scene_.creep_exponent;
   creep_rate_ = scene_.has(Effect::plasticity) ? scene_.creep_rate() : 0.0;
+  plastic_.brittle_cap = scene_.brittle_cap;
   if (scene_.has(Effect::softening) && scene_.nonlocal_radius > 0.0) {
     nonlocal_ = NonlocalOpening<Dim>(scene_.nonlocal_radius, scene_.nonlocal_weight, scene_.dx);
     plastic_.explicit_softening = true;

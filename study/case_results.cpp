@@ -67,6 +67,7 @@ std::vector<CaseRecord> read_case_records(Store& store) {
               "m.spacing_q75_over_h, m.depth_q25_over_h, m.depth_median_over_h, "
               "m.depth_q75_over_h, m.spacings_json, " +
               store.under_resolved_column() +
+              ", json_extract(c.result_json, '$.measurement.depths_m'), c.dx_m" +
               " FROM cases c LEFT JOIN summaries m USING (case_id) ORDER BY c.case_index, "
               "c.replica, c.case_id");
   std::vector<CaseRecord> out;
@@ -97,14 +98,19 @@ std::vector<CaseRecord> read_case_records(Store& store) {
     r.fragmented = s.integer(k++) != 0;
     for (auto& q : r.spacing_over_h) q = s.optional_real(k++);
     for (auto& q : r.depth_over_h) q = s.optional_real(k++);
-    if (!s.is_null(k)) {
-      const auto j = parse_stored_json(s.text(k));
+    // A stored JSON array of numbers (absent for cases without a measurement).
+    const auto numbers = [&](int column, std::vector<double>& into) {
+      if (s.is_null(column)) return;
+      const auto j = parse_stored_json(s.text(column));
       if (j.is_array())
         for (const auto& v : j)
-          if (v.is_number()) r.spacings_m.push_back(v.get<double>());
-    }
-    ++k;
+          if (v.is_number()) into.push_back(v.get<double>());
+    };
+    numbers(k++, r.spacings_m);
     r.under_resolved = s.integer(k++) != 0;
+    numbers(k++, r.depths_m);
+    r.dx_m = s.is_null(k) ? 0.0 : s.real(k);
+    ++k;
     out.push_back(std::move(r));
   }
   if (out.empty()) throw InputError(where + ": the study has no cases");

@@ -58,6 +58,8 @@ struct CaseRecord {
   // q25, median, q75 of L_p/H_i and of D_p/H_i (empty when nothing was measured).
   std::array<std::optional<double>, 3> spacing_over_h, depth_over_h;
   std::vector<double> spacings_m;  // every spacing kept [m]
+  std::vector<double> depths_m;    // every crevasse's depth [m]
+  double dx_m = 0.0;               // the case's grid spacing [m]
 
   double thickness_m() const { return groups[1].value_or(0.0); }
   double cohesion_ratio() const { return groups[0].value_or(0.0); }

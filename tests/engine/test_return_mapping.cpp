@@ -288,5 +288,28 @@ TEST(ReturnMapping, SnapBackSofteningIsStable3d) {
   for (const double step : {1e-6, 1e-5, 1e-3, 1e-1}) check_snap_back_stable<3>(step);
 }
 
+// The brittle cap: a state past the cap keeps no elastic strain (no stress, shear included) and
+// its whole trial trace becomes opening; a state inside the cap is returned as before.
+TEST(ReturnMapping, BrittleCapDropsTheWholeStress) {
+  const ElasticModuli m = ElasticModuli::from_young_poisson(1e9, 0.3);
+  CappedVonMisesParams p;
+  p.tensile_strength_c = 1e5;
+  p.shear_strength_qy = 1e6;
+  p.softening_zeta = 500.0;
+  p.brittle_cap = true;
+  const Vec<2> past(2.0e-4, 1.5e-4);  // p = −K·3.5e-4 ≈ −0.34 MPa, past −c
+  const auto r = return_map_capped_von_mises<2>(past, 0.0, m, p);
+  EXPECT_TRUE(r.cap_active);
+  EXPECT_EQ(r.eps, Vec<2>::Zero());
+  EXPECT_DOUBLE_EQ(r.delta_eps_v, past.sum());
+  const Vec<2> inside(2.0e-5, -1.0e-5);
+  p.brittle_cap = false;
+  const auto plain = return_map_capped_von_mises<2>(inside, 0.0, m, p);
+  p.brittle_cap = true;
+  const auto brittle = return_map_capped_von_mises<2>(inside, 0.0, m, p);
+  EXPECT_EQ(brittle.eps, plain.eps);
+  EXPECT_FALSE(brittle.cap_active);
+}
+
 }  // namespace
 }  // namespace crevasse

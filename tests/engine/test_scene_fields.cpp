@@ -143,6 +143,7 @@ TEST(SceneFields, EachKeyReachesItsOwnMember) {
   EXPECT_FALSE(j["ice"]["softening"].contains("nonlocal_weight"));
   EXPECT_FALSE(j["ice"]["softening"].contains("cap_relaxation_time"));
   EXPECT_FALSE(j["bed"].contains("lip_radius"));
+  EXPECT_FALSE(j["ice"]["softening"].contains("brittle_cap"));
   j["ice"]["softening"]["nonlocal_radius"] = 30.0;
   j["ice"]["softening"]["nonlocal_weight"] = 1.5;
   j["ice"]["softening"]["cap_relaxation_time"] = 0.1;

@@ -8,10 +8,13 @@
 #include <cmath>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <optional>
 #include <random>
 #include <regex>
+#include <sstream>
 
+#include "analysis/measurement_io.hpp"
 #include "study/field_observations.hpp"
 #include "study/fits_table.hpp"
 #include "study_test_support.hpp"
@@ -85,6 +88,7 @@ void write_synthetic_db(const std::filesystem::path& db, int n_pi,
             analysis::QuartileSummary{0.9 * f.depth_over_h, f.depth_over_h, 1.1 * f.depth_over_h};
       }
       r.measurement = m;
+      r.result_json["measurement"] = analysis::measurement_summary_json(m);  // as the runner stores it
     }
     r.wall_s = 1.0 + static_cast<double>(c.index);  // cost grows with the index
     r.particle_steps = 1000 * (c.index + 1);
@@ -322,19 +326,64 @@ TEST(FitCli, PlotWritesEveryFigureWithEveryCaseMarked) {
   EXPECT_NE(plot.out.find("24 case(s) drawn (no value: 1 failed, 1 no crevasse)"),
             std::string::npos)
       << plot.out;
-  for (const char* stem : {"spacing_vs_cohesion_ratio", "depth_vs_cohesion_ratio", "spacing_cdf"})
+  for (const char* stem : {"spacing_vs_cohesion_ratio", "depth_vs_cohesion_ratio", "spacing_cdf", "depth_cdf"})
     for (const char* ext : {".png", ".svg"})
       EXPECT_GT(std::filesystem::file_size(dir / "figs" / (std::string(stem) + ext)), 1000u)
           << stem << ext;
   const std::string depth_svg = test::read_file(dir / "figs" / "depth_vs_cohesion_ratio.svg");
   for (const char* text : {"legend: failed", "legend: no crevasse", "legend: H_i = 100 m",
-                           "legend: H_i = 300 m", "broken-line fit", "b_1 = ", "Π^* = "})
+                           "legend: H_i = 300 m", "broken-line fit", "b_1 = ", "Π^* = ",
+                           "legend: Nye's zero-stress depth"})
     EXPECT_NE(depth_svg.find(text), std::string::npos) << text;
+  // Every floor 3 dx/H_i (0.03 and 0.01) lies below every Π drawn: no band, no legend entry.
+  EXPECT_EQ(depth_svg.find("under-resolved below"), std::string::npos);
+  EXPECT_EQ(test::read_file(dir / "figs" / "spacing_vs_cohesion_ratio.svg").find("Nye"), std::string::npos);
+  const std::string depth_cdf = test::read_file(dir / "figs" / "depth_cdf.svg");
+  EXPECT_NE(depth_cdf.find("D_p/H_i"), std::string::npos);
+  EXPECT_NE(depth_cdf.find("case 23: "), std::string::npos);
   const std::string spacing_svg = test::read_file(dir / "figs" / "spacing_vs_cohesion_ratio.svg");
   EXPECT_NE(spacing_svg.find("power-law fit"), std::string::npos);
   const std::string cdf_svg = test::read_file(dir / "figs" / "spacing_cdf.svg");
   EXPECT_NE(cdf_svg.find("case 23: "), std::string::npos);
   EXPECT_NE(cdf_svg.find("L_p/H_i"), std::string::npos);
+}
+
+// At dx = 10 m the floors 3 dx/H_i = 0.3 (H_i = 100 m) and 0.1 (300 m) fall inside the Π range:
+// both diagrams shade them (one legend entry), under-resolved cases are hollow, and the depth
+// diagram's Nye line rises as 2Π and stops at the bed (D_p/H_i = 1).
+TEST(FitCli, PlotShadesEachThicknessFloorAndDrawsNyesDepth) {
+  test::ScratchDir dir("fit");
+  write_synthetic_db(dir / "s.db", 8, {100.0, 300.0}, known_laws(0.05),
+                     [](nlohmann::json& j) { j["base_scene"]["numerics"]["dx"] = 10.0; });
+  ASSERT_EQ(test::run_cli(dir.path(), "fit s.db").code, 0);
+  ASSERT_EQ(test::run_cli(dir.path(), "plot s.db --out figs --cdf-normalise bending").code, 0);
+  for (const char* stem : {"spacing_vs_cohesion_ratio", "depth_vs_cohesion_ratio"}) {
+    const std::string svg = test::read_file(dir / "figs" / (std::string(stem) + ".svg"));
+    EXPECT_NE(svg.find("legend: under-resolved below"), std::string::npos) << stem;
+    EXPECT_NE(svg.find("legend: under-resolved: c/(ρ_i g) &lt; 3 dx, not fitted"), std::string::npos) << stem;
+  }
+  EXPECT_NE(test::read_file(dir / "figs" / "spacing_cdf.svg").find("L_p / sqrt(c H_i/(ρ_i g))"), std::string::npos);
+}
+
+// status's >H/2 column: the share of a case's crevasses deeper than H_i/2. The synthetic cases'
+// crevasses all have the depth D_p/H_i = 0.8 (Π/0.2)^b: 0.2 at Π = 0.05, 0.8 at Π = 0.2, 1.3 at 1.
+TEST(FitCli, StatusGivesTheShareOfCrevassesDeeperThanHalfTheIce) {
+  test::ScratchDir dir("fit");
+  write_synthetic_db(dir / "s.db", 5, {100.0}, known_laws(0.0));
+  const test::CliResult status = test::run_cli(dir.path(), "status s.db --all");
+  ASSERT_EQ(status.code, 0) << status.err;
+  EXPECT_NE(status.out.find(">H/2"), std::string::npos) << status.out;
+  std::istringstream lines(status.out);
+  std::map<std::string, std::string> share;  // Π column → >H/2 column
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream row(line);
+    std::string index, id, h, pi, r, slope, count, l, d, deeper;
+    if (row >> index >> id >> h >> pi >> r >> slope >> count >> l >> d >> deeper &&
+        index.find_first_not_of("0123456789") == std::string::npos)
+      share[pi] = deeper;
+  }
+  EXPECT_EQ(share["0.05"], "0%") << status.out;
+  EXPECT_EQ(share["1"], "100%") << status.out;
 }
 
 // --add-cases draws another study's cases on the diagram under their study's name, without

@@ -536,6 +536,18 @@ TEST(Reliability, KillsDuringFitExportPlotAndMergeLeaveOldOrWholeNew) {
     EXPECT_NE(e.path().filename().string().front(), '.') << e.path() << " left behind";
 }
 
+// A command killed between the probe of its output folder and the probe's removal leaves the
+// probe file; the next command writing there removes it.
+TEST(Reliability, AProbeLeftByAKilledCommandIsClearedByTheNext) {
+  test::ScratchDir dir("rel_probe");
+  test::write_text(dir / "s.json", test::tiny_study(2, 300, "probe").dump(2));
+  ASSERT_EQ(run_cli(dir.path(), "study s.json --db s.db --quiet").code, 0);
+  fs::create_directories(dir / "csv");
+  test::write_text(dir / "csv" / ".crevasse-probe-AbC123", "");
+  ASSERT_EQ(run_cli(dir.path(), "export s.db --csv csv").code, 0);
+  EXPECT_FALSE(fs::exists(dir / "csv" / ".crevasse-probe-AbC123"));
+}
+
 // A full disk (here a file-size limit of 4 KiB, with SIGXFSZ ignored) midway through export or
 // plot leaves each file as it was or whole, never truncated, and the command exits non-zero.
 TEST(Reliability, FullDiskLeavesOldOrWholeFiles) {
