@@ -572,8 +572,16 @@ class Renderer {
     draw_text(cr_, 0.0, 0.0, figure_.y_axis().label, label);
     cairo_restore(cr_);
     if (!figure_.title().empty()) {
-      draw_text(cr_, 0.5 * (left_ + right_), 10.0 + kTitleFontPt, figure_.title(),
-                {kTitleFontPt, kBlack, TextAnchor::centre});
+      // A long title (a study's name and protocol) shrinks to the figure's width, and is centred
+      // over the axes where it fits, else as near to that as the figure's edges let it be.
+      constexpr double kEdge = 8.0;
+      const double room = figure_.width_pt() - 2.0 * kEdge;
+      double size = kTitleFontPt;
+      const double full = text_width(cr_, figure_.title(), size);
+      if (full > room) size = std::max(6.0, size * room / full);
+      const double half = 0.5 * text_width(cr_, figure_.title(), size);
+      const double x = std::clamp(0.5 * (left_ + right_), kEdge + half, std::max(kEdge + half, figure_.width_pt() - kEdge - half));
+      draw_text(cr_, x, 10.0 + kTitleFontPt, figure_.title(), {size, kBlack, TextAnchor::centre});
     }
   }
 
