@@ -7,7 +7,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
-cmake --build build -j "$(nproc)"
+cmake --build build -j "$(nproc)" --target crevasse  # the tests are built by scripts/test.sh
 mkdir -p runs
 ./build/cli/crevasse study studies/quick.json --db runs/quick.db --views runs/quick_figures/cases
 ./build/cli/crevasse status runs/quick.db
