@@ -32,6 +32,7 @@ class NonlocalOpening {
   // Reads x, mass, ε_v^p; writes ε̂ of every particle (at()).
   void compute(const Particles<Dim>& P, const Grid<Dim>& grid, const ParticleColouring<Dim>& colouring);
   double at(std::size_t p) const { return eps_hat_[p]; }
+  const double* values() const { return eps_hat_.data(); }
 
  private:
   struct Offset {

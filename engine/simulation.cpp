@@ -309,6 +309,7 @@ void Simulation<Dim>::scatter_to_grid() {
   const bool plastic = Average && !P.eps_v_p.empty();
   const bool damage = Average && averaging_weights_damage();
   average_.keep_softening_of(plastic ? P.size() : 0);
+  const double* const opening = plastic ? openings_for_softening() : nullptr;
   const std::array<std::size_t, Dim> stride = grid_.strides();
   GridNode<Dim>* const nodes = grid_.nodes.data();
   colouring_.for_each([&](std::uint32_t p) __attribute__((always_inline)) {
@@ -321,7 +322,7 @@ void Simulation<Dim>::scatter_to_grid() {
     const Vec<Dim> mv = m * P.v[p];
     double wm = 0.0;
     if constexpr (Average) {
-      const double f = plastic ? softening_factor(plastic_, opening_for_softening(p)) : 1.0;
+      const double f = plastic ? softening_factor(plastic_, opening[p]) : 1.0;
       if (plastic) average_.keep_softening(p, f);
       wm = average_.weight(P, p, damage);
     }
@@ -374,6 +375,7 @@ void Simulation<Dim>::update_particles() {
   const bool damage = Average && averaging_weights_damage();
   const bool kept_softening = average_.kept_softening();  // P2G kept e^{−ζ ε_v^p} (averaged, plastic)
   const ParticleEffects<Dim> effects = particle_effects_now();
+  const double* const opening = Plastic && !Average ? openings_for_softening() : nullptr;
   plastic_.creep_increment = dt_ * creep_rate_;
   if (scene_.cap_relaxation_time > 0.0) {
     const double r = dt_ / scene_.cap_relaxation_time;
@@ -393,7 +395,7 @@ void Simulation<Dim>::update_particles() {
       soft = kept_softening ? average_.softening(p) : 1.0;
     } else {
       gather_velocity(P, grid_, p, w, StencilOffsets<Dim>(w, xg, dx), grid_.flat(w.base()), c_scale);
-      soft = Plastic ? softening_factor(plastic_, opening_for_softening(p)) : 1.0;
+      soft = Plastic ? softening_factor(plastic_, opening[p]) : 1.0;
     }
   };
   summary_ = tbb::parallel_reduce(

@@ -167,10 +167,10 @@ class Simulation {
   // x); writes dt_, max_speed_, front_x_; throws SimulationError on an instability.
   void update_time_step();
 
-  // What particle p's softening reads: its own ε_v^p, or the nonlocal ε̂ (nonlocal_), which
-  // stays 0 while settling (no opening yet).
-  double opening_for_softening(std::size_t p) const {
-    return nonlocal_.active() && !settling_.active ? nonlocal_.at(p) : particles_.eps_v_p[p];
+  // What each particle's softening reads: its own ε_v^p, or the nonlocal ε̂ (nonlocal_), which
+  // is not computed while settling (no opening yet). Read once per sweep, not per particle.
+  const double* openings_for_softening() const {
+    return nonlocal_.active() && !settling_.active ? nonlocal_.values() : particles_.eps_v_p.data();
   }
 
   SceneConfig scene_;
