@@ -366,7 +366,8 @@ TEST(FitCli, PlotShadesEachThicknessFloorAndDrawsNyesDepth) {
 }
 
 // status's >H/2 column: the share of a case's crevasses deeper than H_i/2. The synthetic cases'
-// crevasses all have the depth D_p/H_i = 0.8 (Π/0.2)^b: 0.2 at Π = 0.05, 0.8 at Π = 0.2, 1.3 at 1.
+// crevasses all have the depth D_p/H_i = 0.8 (Π/0.2)^b: 0.2 at Π = 0.05, 0.42 at 0.1057, 0.83 at
+// 0.2236, 1.3 at 1; the two middle ones pin the threshold between 0.42 and 0.83 H_i.
 TEST(FitCli, StatusGivesTheShareOfCrevassesDeeperThanHalfTheIce) {
   test::ScratchDir dir("fit");
   write_synthetic_db(dir / "s.db", 5, {100.0}, known_laws(0.0));
@@ -383,6 +384,8 @@ TEST(FitCli, StatusGivesTheShareOfCrevassesDeeperThanHalfTheIce) {
       share[pi] = deeper;
   }
   EXPECT_EQ(share["0.05"], "0%") << status.out;
+  EXPECT_EQ(share["0.1057"], "0%") << status.out;
+  EXPECT_EQ(share["0.2236"], "100%") << status.out;
   EXPECT_EQ(share["1"], "100%") << status.out;
 }
 
