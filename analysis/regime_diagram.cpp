@@ -323,4 +323,16 @@ Figure empirical_cdf_figure(const std::vector<NamedSample>& samples,
   return figure;
 }
 
+ReferenceCurve nye_zero_stress_depth(double pi_lo, double pi_hi, int points) {
+  if (!(pi_lo > 0.0) || !(pi_hi >= pi_lo) || !std::isfinite(pi_hi) || points < 1)
+    throw std::invalid_argument("Nye's depth needs 0 < Π_lo <= Π_hi and at least one point");
+  ReferenceCurve nye{"Nye's zero-stress depth, D_p/H_i = 2Π", {}, {}};
+  for (int i = 0; i <= points; ++i) {
+    const double x = pi_lo * std::pow(pi_hi / pi_lo, static_cast<double>(i) / points);
+    nye.x.push_back(x);
+    nye.y.push_back(std::min(1.0, 2.0 * x));
+  }
+  return nye;
+}
+
 }  // namespace crevasse::analysis

@@ -38,6 +38,11 @@ struct ReferenceCurve {
   std::vector<double> x, y;
 };
 
+// Nye's zero-stress depth D = 2c/(ρ_i g) as D/H_i = 2Π, capped at the bed (D/H_i = 1), sampled
+// log-evenly over [pi_lo, pi_hi] (docs/fits.md, "Nye's zero-stress depth"). Throws
+// std::invalid_argument unless 0 < pi_lo <= pi_hi and points >= 1.
+ReferenceCurve nye_zero_stress_depth(double pi_lo, double pi_hi, int points = 64);
+
 struct RegimeDiagramOptions {
   std::string title;
   std::vector<ReferenceCurve> references;

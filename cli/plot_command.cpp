@@ -93,13 +93,8 @@ void add_references(analysis::RegimeDiagramOptions& options, Quantity q,
     lo = std::min(lo, p.pi);
     hi = std::max(hi, p.pi);
   }
-  analysis::ReferenceCurve nye{"Nye's zero-stress depth, D_p/H_i = 2Π", {}, {}};
-  constexpr int kPoints = 64;
-  for (int i = 0; i <= kPoints && hi > 0.0; ++i) {
-    const double x = lo * std::pow(hi / lo, static_cast<double>(i) / kPoints);
-    nye.x.push_back(x);
-    nye.y.push_back(std::min(1.0, 2.0 * x));
-  }
+  if (hi <= 0.0) return;
+  analysis::ReferenceCurve nye = analysis::nye_zero_stress_depth(lo, hi);
   options.references.push_back(std::move(nye));
 }
 
