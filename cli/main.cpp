@@ -93,6 +93,8 @@ int run_command_line(int argc, char** argv) {
   study->add_option("--threads-per-case", study_opt.threads_per_case, "Engine threads per case (default 1)")->check(CLI::Range(1, 1024));
   study->add_option("--case-time-limit", study_opt.case_time_limit_s, "Wall seconds per case, 0 = none (default: the study's resources)")->check(CLI::Range(0.0, 1e8));
   study->add_option("--shard", study_opt.shard, "Run only shard I of N (I/N, 0 <= I < N)");
+  study->add_option("--cases", study_opt.cases,
+                    "Run only these cases, by index as --dry-run lists them (e.g. 30,33 or 20-25); the others stay pending");
   study->add_flag("--fail-fast", study_opt.fail_fast, "Stop at the first failing case");
   study->add_flag("--retry-failed", study_opt.retry_failed, "Run cases stored as failed again");
   study->add_flag("--dry-run", study_opt.dry_run, "List the cases and their hashes; run nothing");

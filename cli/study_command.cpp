@@ -205,6 +205,7 @@ int study_command(const StudyCommandOptions& opt) {
   ro.fail_fast = opt.fail_fast;
   ro.retry_failed = opt.retry_failed;
   ro.shard = shard;
+  if (!opt.cases.empty()) ro.only_cases = parse_case_list(opt.cases, study.cases.size());
   ro.command = opt.command_line;
   ro.views_dir = opt.views_dir;
   ro.particles_dir = particles_dir;

@@ -12,6 +12,7 @@ struct StudyCommandOptions {
   int threads_per_case = 0;         // 0 → resources.threads_per_case, else 1
   double case_time_limit_s = -1.0;  // < 0 → resources.case_time_limit_s
   std::string shard;                // "I/N" or ""
+  std::string cases;                // "--cases" list or ""
   bool fail_fast = false;
   bool retry_failed = false;
   bool dry_run = false;  // list the cases and their hashes; run nothing, create nothing

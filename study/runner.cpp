@@ -237,9 +237,18 @@ class StudyRun {
     session.shard = opt_.shard ? opt_.shard->text() : "";
     session.command = opt_.command;
 
+    for (std::size_t i : opt_.only_cases)
+      if (std::none_of(scope.begin(), scope.end(), [i](const StudyCase* c) { return c->index == i; }))
+        throw InputError("--cases: case " + std::to_string(i) + " is not in shard " +
+                         (opt_.shard ? opt_.shard->text() : std::string("0/1")));
+    const auto selected = [this](const StudyCase* c) {
+      return opt_.only_cases.empty() ||
+             std::binary_search(opt_.only_cases.begin(), opt_.only_cases.end(), c->index);
+    };
     const auto status = store_.statuses();
     for (const StudyCase* c : scope) {
       const std::string& st = status.at(c->case_id);
+      if (!selected(c)) continue;
       if (st == "done")
         ++report_.already_done;
       else if (st == "failed" && !opt_.retry_failed)

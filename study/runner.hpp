@@ -63,6 +63,9 @@ struct RunnerOptions {
   bool fail_fast = false;
   bool retry_failed = false;  // run cases stored as failed again
   std::optional<Shard> shard;
+  // Non-empty: run only these cases (indices, sorted; parse_case_list); the others in scope stay
+  // as they are. Each must be in scope (in the shard, with --shard).
+  std::vector<std::size_t> only_cases;
   std::string command;         // recorded in the sessions table
   CaseFunction case_function;  // empty: run_engine_case (engine_case.hpp)
   StudyObserver* observer = nullptr;

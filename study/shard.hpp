@@ -22,4 +22,9 @@ Shard parse_shard(const std::string& text);
 // The cases of `study` in shard `shard`, in enumeration order.
 std::vector<const StudyCase*> shard_cases(const Study& study, const Shard& shard);
 
+// `--cases LIST`: case indices as `--dry-run` lists them, comma-separated, a-b for a range
+// (e.g. "30,33" or "20-25,38"); sorted, without repeats. Throws InputError naming --cases and
+// the allowed range [0, case_count - 1] otherwise.
+std::vector<std::size_t> parse_case_list(const std::string& text, std::size_t case_count);
+
 }  // namespace crevasse

@@ -3,6 +3,7 @@
 // up in the database with their crevasse measurements.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <mutex>
 #include <set>
@@ -87,6 +88,70 @@ TEST(Runner, FailFastStopsAtTheFirstFailureAndLeavesTheRestPending) {
                       "case_index)")
           .at(0),
       "done,failed,pending,pending,pending");
+}
+
+TEST(Runner, OnlyTheChosenCasesRunAndTheOthersStayPending) {
+  test::ScratchDir dir("runner");
+  const Study study = test::parse(test::tiny_study(5));
+  std::mutex m;
+  std::set<std::size_t> ran;
+  auto fn = [&](const StudyCase& c, CaseContext&) {
+    std::lock_guard lock(m);
+    ran.insert(c.index);
+    return test::fake_outcome(c);
+  };
+  RunnerOptions o = fake_options(dir / "s.db", fn);
+  o.only_cases = parse_case_list("3,1", study.cases.size());
+  const RunnerReport r = run_study(study, o);
+  EXPECT_EQ(r.done, 2u);
+  EXPECT_EQ(ran, (std::set<std::size_t>{1, 3}));
+  const std::string order =
+      "SELECT group_concat(status, ',') FROM (SELECT status FROM cases ORDER BY case_index)";
+  EXPECT_EQ(test::dump_rows(dir / "s.db", order).at(0), "pending,done,pending,done,pending");
+  // The next session without a choice runs the rest, not the chosen cases again.
+  ran.clear();
+  run_study(study, fake_options(dir / "s.db", fn));
+  EXPECT_EQ(ran, (std::set<std::size_t>{0, 2, 4}));
+  EXPECT_EQ(test::dump_rows(dir / "s.db", order).at(0), "done,done,done,done,done");
+}
+
+TEST(Runner, ACaseListIsParsedOrRefusedNamingTheOption) {
+  EXPECT_EQ(parse_case_list("30,33", 40), (std::vector<std::size_t>{30, 33}));
+  EXPECT_EQ(parse_case_list("5-7,2,6", 40), (std::vector<std::size_t>{2, 5, 6, 7}));
+  EXPECT_EQ(parse_case_list("0", 1), (std::vector<std::size_t>{0}));
+  for (const char* bad : {"", "a", "1,,2", "3-", "-3", "1.5", "40", "7-3"}) {
+    try {
+      parse_case_list(bad, 40);
+      ADD_FAILURE() << "accepted '" << bad << "'";
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind("--cases: ", 0), 0u) << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+  }
+  try {
+    parse_case_list("40", 40);
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("[0, 39]"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Runner, AChosenCaseOutsideTheShardIsRefusedBeforeAnythingRuns) {
+  test::ScratchDir dir("runner");
+  const Study study = test::parse(test::tiny_study(4));
+  const auto in_shard = shard_cases(study, Shard{0, 2});
+  std::size_t outside = 0;
+  while (std::any_of(in_shard.begin(), in_shard.end(), [&](const StudyCase* c) { return c->index == outside; }))
+    ++outside;
+  bool ran = false;
+  RunnerOptions o = fake_options(dir / "s.db", [&](const StudyCase& c, CaseContext&) {
+    ran = true;
+    return test::fake_outcome(c);
+  });
+  o.shard = Shard{0, 2};
+  o.only_cases = {outside};
+  EXPECT_THROW(run_study(study, o), InputError);
+  EXPECT_FALSE(ran);
 }
 
 // A case function for fail-fast: case 0 fails after `delay`; every other case runs until it is
