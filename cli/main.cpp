@@ -22,7 +22,7 @@
 #include "cli/status_command.hpp"
 #include "cli/study_command.hpp"
 #include "engine/error.hpp"
-#include "study/json_checks.hpp"
+#include "engine/json_input.hpp"
 #include "study/memory_reserve.hpp"
 #include "study/merge.hpp"
 

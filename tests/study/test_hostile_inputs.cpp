@@ -11,7 +11,7 @@
 #include <set>
 #include <thread>
 
-#include "study/json_checks.hpp"
+#include "engine/json_input.hpp"
 #include "study/store.hpp"
 #include "study_test_support.hpp"
 
