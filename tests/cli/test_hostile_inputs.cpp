@@ -13,7 +13,7 @@
 
 #include "engine/json_input.hpp"
 #include "study/store.hpp"
-#include "study_test_support.hpp"
+#include "../study/study_test_support.hpp"
 
 namespace crevasse {
 namespace {
