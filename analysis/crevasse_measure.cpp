@@ -14,6 +14,7 @@
 #include "analysis/damage_clusters.hpp"
 #include "analysis/damage_criterion.hpp"
 #include "analysis/opened_gaps.hpp"
+#include "engine/json_input.hpp"
 
 namespace crevasse::analysis {
 
@@ -86,13 +87,7 @@ bool is_measure_frame(const std::string& name) {
   return std::find(std::begin(kFrames), std::end(kFrames), name) != std::end(kFrames);
 }
 
-std::string measure_frame_names() {
-  std::string out;
-  const std::size_t n = std::size(kFrames);
-  for (std::size_t i = 0; i < n; ++i)
-    out += (i == 0 ? "" : i + 1 == n ? " or " : ", ") + std::string("'") + kFrames[i] + "'";
-  return out;
-}
+std::string measure_frame_names() { return name_list({std::begin(kFrames), std::end(kFrames)}, true); }
 
 void check_measure_scales(const MeasureSettings& settings, const MeasureScales& run) {
   const auto within = [](const std::optional<double>& value, double scale, const char* key, const char* symbol) {

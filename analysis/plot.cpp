@@ -1,7 +1,6 @@
 #include "analysis/plot.hpp"
 
 #include <cairo-svg.h>
-#include <cairo.h>
 
 #include <algorithm>
 #include <cmath>
@@ -13,10 +12,14 @@
 #include <regex>
 #include <stdexcept>
 
+#include "analysis/cairo_canvas.hpp"
 #include "engine/atomic_file.hpp"
 
 namespace crevasse::analysis {
 namespace {
+
+using canvas::segment;
+using canvas::set_color;
 
 constexpr const char* kFontFamily = "sans-serif";
 constexpr double kTickFontPt = 9.0;
@@ -270,8 +273,6 @@ Range data_range(const std::vector<Figure::Item>& items, bool x_axis, AxisScale 
 
 // ---- Primitives -----------------------------------------------------------------------------
 
-void set_color(cairo_t* cr, const Color& c) { cairo_set_source_rgba(cr, c.r, c.g, c.b, c.a); }
-
 void apply_line_style(cairo_t* cr, const LineStyle& style) {
   set_color(cr, style.color);
   cairo_set_line_width(cr, style.width_pt);
@@ -305,16 +306,12 @@ void draw_marker(cairo_t* cr, double x, double y, const MarkerStyle& style) {
       cairo_close_path(cr);
       break;
     case MarkerShape::cross:
-      cairo_move_to(cr, x - r, y - r);
-      cairo_line_to(cr, x + r, y + r);
-      cairo_move_to(cr, x - r, y + r);
-      cairo_line_to(cr, x + r, y - r);
+      segment(cr, x - r, y - r, x + r, y + r);
+      segment(cr, x - r, y + r, x + r, y - r);
       break;
     case MarkerShape::plus:
-      cairo_move_to(cr, x - r, y);
-      cairo_line_to(cr, x + r, y);
-      cairo_move_to(cr, x, y - r);
-      cairo_line_to(cr, x, y + r);
+      segment(cr, x - r, y, x + r, y);
+      segment(cr, x, y - r, x, y + r);
       break;
   }
   cairo_set_dash(cr, nullptr, 0, 0.0);
@@ -349,14 +346,13 @@ class Renderer {
     cairo_paint(cr_);
     layout();
     draw_grid();
-    cairo_save(cr_);
-    cairo_rectangle(cr_, left_, top_, right_ - left_, bottom_ - top_);
-    cairo_clip(cr_);
-    // Shaded regions under lines under markers: order by kind, then by call order.
-    for (int pass = 0; pass < 4; ++pass) {
-      for (const Figure::Item& item : figure_.items()) draw_item(item, pass);
+    {
+      const canvas::Clip clip(cr_, left_, top_, right_ - left_, bottom_ - top_);
+      // Shaded regions under lines under markers: order by kind, then by call order.
+      for (int pass = 0; pass < 4; ++pass) {
+        for (const Figure::Item& item : figure_.items()) draw_item(item, pass);
+      }
     }
-    cairo_restore(cr_);
     for (const Figure::Item& item : figure_.items()) draw_item(item, 4);
     draw_axes();
     draw_legend();
@@ -389,13 +385,11 @@ class Renderer {
     cairo_set_dash(cr_, nullptr, 0, 0.0);
     for (const Tick& tick : x_.ticks()) {
       if (tick.label.empty()) continue;
-      cairo_move_to(cr_, px(tick.value), top_);
-      cairo_line_to(cr_, px(tick.value), bottom_);
+      segment(cr_, px(tick.value), top_, px(tick.value), bottom_);
     }
     for (const Tick& tick : y_.ticks()) {
       if (tick.label.empty()) continue;
-      cairo_move_to(cr_, left_, py(tick.value));
-      cairo_line_to(cr_, right_, py(tick.value));
+      segment(cr_, left_, py(tick.value), right_, py(tick.value));
     }
     cairo_stroke(cr_);
   }
@@ -462,12 +456,9 @@ class Renderer {
         continue;
       }
       const double x = px(bars.x[i]), lo = py(bars.y_low[i]), hi = py(bars.y_high[i]);
-      cairo_move_to(cr_, x, lo);
-      cairo_line_to(cr_, x, hi);
-      cairo_move_to(cr_, x - cap, lo);
-      cairo_line_to(cr_, x + cap, lo);
-      cairo_move_to(cr_, x - cap, hi);
-      cairo_line_to(cr_, x + cap, hi);
+      segment(cr_, x, lo, x, hi);
+      segment(cr_, x - cap, lo, x + cap, lo);
+      segment(cr_, x - cap, hi, x + cap, hi);
     }
     cairo_stroke(cr_);
   }
@@ -490,8 +481,7 @@ class Renderer {
   void draw_vertical_line(const Figure::VerticalLine& line) {
     if (!x_.drawable(line.x)) return;
     apply_line_style(cr_, line.style);
-    cairo_move_to(cr_, px(line.x), top_);
-    cairo_line_to(cr_, px(line.x), bottom_);
+    segment(cr_, px(line.x), top_, px(line.x), bottom_);
     cairo_stroke(cr_);
   }
 
@@ -545,20 +535,16 @@ class Renderer {
     const TextStyle tick_right{kTickFontPt, kBlack, TextAnchor::right};
     for (const Tick& tick : x_.ticks()) {
       const double x = px(tick.value), length = tick.label.empty() ? 2.5 : 5.0;
-      cairo_move_to(cr_, x, bottom_);
-      cairo_line_to(cr_, x, bottom_ - length);
-      cairo_move_to(cr_, x, top_);
-      cairo_line_to(cr_, x, top_ + length);
+      segment(cr_, x, bottom_, x, bottom_ - length);
+      segment(cr_, x, top_, x, top_ + length);
       cairo_stroke(cr_);
       if (!tick.label.empty())
         draw_text(cr_, x, bottom_ + 4.0 + kTickFontPt * 1.1, tick.label, tick_centre);
     }
     for (const Tick& tick : y_.ticks()) {
       const double y = py(tick.value), length = tick.label.empty() ? 2.5 : 5.0;
-      cairo_move_to(cr_, left_, y);
-      cairo_line_to(cr_, left_ + length, y);
-      cairo_move_to(cr_, right_, y);
-      cairo_line_to(cr_, right_ - length, y);
+      segment(cr_, left_, y, left_ + length, y);
+      segment(cr_, right_, y, right_ - length, y);
       cairo_stroke(cr_);
       if (!tick.label.empty())
         draw_text(cr_, left_ - 4.0, y + 0.35 * kTickFontPt, tick.label, tick_right);
@@ -566,11 +552,8 @@ class Renderer {
     const TextStyle label{kLabelFontPt, kBlack, TextAnchor::centre};
     draw_text(cr_, 0.5 * (left_ + right_), figure_.height_pt() - 10.0, figure_.x_axis().label,
               label);
-    cairo_save(cr_);
-    cairo_translate(cr_, 8.0 + kLabelFontPt, 0.5 * (top_ + bottom_));
-    cairo_rotate(cr_, -0.5 * std::numbers::pi);
-    draw_text(cr_, 0.0, 0.0, figure_.y_axis().label, label);
-    cairo_restore(cr_);
+    canvas::turned_up(cr_, 8.0 + kLabelFontPt, 0.5 * (top_ + bottom_),
+                      [&] { draw_text(cr_, 0.0, 0.0, figure_.y_axis().label, label); });
     if (!figure_.title().empty()) {
       // A long title (a study's name and protocol) shrinks to the figure's width, and is centred
       // over the axes where it fits, else as near to that as the figure's edges let it be.
@@ -639,8 +622,7 @@ class Renderer {
           } else if constexpr (std::is_same_v<T, Figure::Line> ||
                                std::is_same_v<T, Figure::VerticalLine>) {
             apply_line_style(cr_, it.style);
-            cairo_move_to(cr_, x0, y);
-            cairo_line_to(cr_, x1, y);
+            segment(cr_, x0, y, x1, y);
             cairo_stroke(cr_);
           } else if constexpr (std::is_same_v<T, Figure::Band> ||
                                std::is_same_v<T, Figure::VerticalBand>) {
@@ -649,8 +631,7 @@ class Renderer {
             cairo_fill(cr_);
           } else if constexpr (std::is_same_v<T, Figure::ErrorBars>) {
             set_color(cr_, it.color);
-            cairo_move_to(cr_, xm, y - 5.0);
-            cairo_line_to(cr_, xm, y + 5.0);
+            segment(cr_, xm, y - 5.0, xm, y + 5.0);
             cairo_stroke(cr_);
           }
         },
@@ -663,23 +644,11 @@ class Renderer {
   double left_ = 0.0, right_ = 0.0, top_ = 0.0, bottom_ = 0.0;
 };
 
-struct SurfaceDeleter {
-  void operator()(cairo_surface_t* s) const { cairo_surface_destroy(s); }
-};
-struct ContextDeleter {
-  void operator()(cairo_t* cr) const { cairo_destroy(cr); }
-};
-using SurfacePtr = std::unique_ptr<cairo_surface_t, SurfaceDeleter>;
-using ContextPtr = std::unique_ptr<cairo_t, ContextDeleter>;
-
 void render(const Figure& figure, cairo_surface_t* surface, double scale) {
-  ContextPtr cr(cairo_create(surface));
+  const canvas::ContextPtr cr = canvas::context(surface, "figure");
   cairo_scale(cr.get(), scale, scale);
   Renderer(figure, cr.get()).draw();
-  if (cairo_status(cr.get()) != CAIRO_STATUS_SUCCESS) {
-    throw std::runtime_error(std::string("figure: drawing failed: ") +
-                             cairo_status_to_string(cairo_status(cr.get())));
-  }
+  canvas::check(cr.get(), "figure");
 }
 
 cairo_status_t append_to_string(void* closure, const unsigned char* data, unsigned int length) {
@@ -821,22 +790,15 @@ void Figure::add_text_in_axes(double fx, double fy, std::string text, TextStyle 
 void Figure::write_png(const std::string& path, double pixels_per_pt) const {
   const int width = static_cast<int>(std::ceil(width_pt_ * pixels_per_pt));
   const int height = static_cast<int>(std::ceil(height_pt_ * pixels_per_pt));
-  SurfacePtr surface(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, width, height));
+  const canvas::SurfacePtr surface = canvas::image(width, height, "figure");
   render(*this, surface.get(), pixels_per_pt);
-  AtomicFile file(path);
-  const cairo_status_t status = cairo_surface_write_to_png(surface.get(), file.temp_path().c_str());
-  if (status != CAIRO_STATUS_SUCCESS) {
-    throw std::runtime_error("figure: cannot write PNG '" + path +
-                             "': " + cairo_status_to_string(status) +
-                             " — check that the folder exists and is writable");
-  }
-  file.commit();
+  canvas::write_png(surface.get(), path, "figure");
 }
 
 std::string Figure::svg() const {
   std::string document;
   {
-    SurfacePtr surface(
+    const canvas::SurfacePtr surface(
         cairo_svg_surface_create_for_stream(append_to_string, &document, width_pt_, height_pt_));
     render(*this, surface.get(), 1.0);
     cairo_surface_finish(surface.get());

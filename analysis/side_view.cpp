@@ -1,23 +1,24 @@
 #include "analysis/side_view.hpp"
 
-#include <cairo.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "analysis/cairo_canvas.hpp"
 #include "analysis/damage_criterion.hpp"
-#include "engine/atomic_file.hpp"
 
 namespace crevasse::analysis {
 
 namespace {
+
+using canvas::segment;
+using canvas::set_color;
+using canvas::show_text;
 
 struct Rgb {
   double r, g, b;
@@ -69,9 +70,6 @@ std::string format_metres(double v) {
   return buf;
 }
 
-using SurfacePtr = std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)>;
-using ContextPtr = std::unique_ptr<cairo_t, decltype(&cairo_destroy)>;
-
 // Maps metres to pixels with one scale for x and z (true aspect ratio).
 struct Frame {
   double x0_m, z1_m, scale_px_per_m;
@@ -80,14 +78,6 @@ struct Frame {
   double py(double z_m) const { return top_px + (z1_m - z_m) * scale_px_per_m; }
 };
 
-void show_text(cairo_t* cr, double x, double y, const std::string& text, double align_x,
-               double align_y) {
-  cairo_text_extents_t e;
-  cairo_text_extents(cr, text.c_str(), &e);
-  cairo_move_to(cr, x - e.x_bearing - align_x * e.width, y - e.y_bearing - align_y * e.height);
-  cairo_show_text(cr, text.c_str());
-}
-
 void draw_bed(cairo_t* cr, const Frame& f, const ParticleSnapshot& s) {
   if (s.bed_profile.size() < 2) return;
   const double bottom = f.top_px + f.height_px;
@@ -95,7 +85,7 @@ void draw_bed(cairo_t* cr, const Frame& f, const ParticleSnapshot& s) {
   for (const auto& v : s.bed_profile) cairo_line_to(cr, f.px(v[0]), f.py(v[1]));
   cairo_line_to(cr, f.px(s.bed_profile.back()[0]), bottom);
   cairo_close_path(cr);
-  cairo_set_source_rgb(cr, 0.62, 0.62, 0.62);
+  set_color(cr, {0.62, 0.62, 0.62});
   cairo_fill(cr);
 }
 
@@ -103,7 +93,7 @@ void draw_bed_outline(cairo_t* cr, const Frame& f, const ParticleSnapshot& s) {
   if (s.bed_profile.size() < 2) return;
   cairo_move_to(cr, f.px(s.bed_profile.front()[0]), f.py(s.bed_profile.front()[1]));
   for (const auto& v : s.bed_profile) cairo_line_to(cr, f.px(v[0]), f.py(v[1]));
-  cairo_set_source_rgb(cr, 0.30, 0.30, 0.30);
+  set_color(cr, {0.30, 0.30, 0.30});
   cairo_set_line_width(cr, 1.5);
   cairo_stroke(cr);
 }
@@ -152,7 +142,7 @@ void paint_particles(cairo_surface_t* surface, const Frame& f, const ParticleSna
 }
 
 void draw_axes(cairo_t* cr, const Frame& f) {
-  cairo_set_source_rgb(cr, 0.15, 0.15, 0.15);
+  set_color(cr, {0.15, 0.15, 0.15});
   cairo_set_line_width(cr, 1.0);
   cairo_rectangle(cr, f.left_px + 0.5, f.top_px + 0.5, f.width_px - 1.0, f.height_px - 1.0);
   cairo_stroke(cr);
@@ -162,8 +152,7 @@ void draw_axes(cairo_t* cr, const Frame& f) {
   const double x1_m = f.x0_m + f.width_px / f.scale_px_per_m;
   for (double x = std::ceil(f.x0_m / x_step) * x_step; x <= x1_m + 1e-9; x += x_step) {
     const double p = std::round(f.px(x)) + 0.5;
-    cairo_move_to(cr, p, bottom);
-    cairo_line_to(cr, p, bottom + 5.0);
+    segment(cr, p, bottom, p, bottom + 5.0);
     cairo_stroke(cr);
     show_text(cr, p, bottom + 8.0, format_metres(x), 0.5, 0.0);
   }
@@ -172,29 +161,24 @@ void draw_axes(cairo_t* cr, const Frame& f) {
   const double z0_m = f.z1_m - f.height_px / f.scale_px_per_m;
   for (double z = std::ceil(z0_m / z_step) * z_step; z <= f.z1_m + 1e-9; z += z_step) {
     const double p = std::round(f.py(z)) + 0.5;
-    cairo_move_to(cr, f.left_px - 5.0, p);
-    cairo_line_to(cr, f.left_px, p);
+    segment(cr, f.left_px - 5.0, p, f.left_px, p);
     cairo_stroke(cr);
     show_text(cr, f.left_px - 8.0, p, format_metres(z), 1.0, 0.5);
   }
-  cairo_save(cr);
-  cairo_translate(cr, 14.0, f.top_px + 0.5 * f.height_px);
-  cairo_rotate(cr, -M_PI / 2.0);
-  show_text(cr, 0.0, 0.0, "z [m]", 0.5, 0.5);
-  cairo_restore(cr);
+  canvas::turned_up(cr, 14.0, f.top_px + 0.5 * f.height_px,
+                    [&] { show_text(cr, 0.0, 0.0, "z [m]", 0.5, 0.5); });
 }
 
 void draw_marks(cairo_t* cr, const Frame& f, const CrevasseMeasurement& m) {
   // The measurement window: two grey dashed verticals over the whole height.
-  cairo_set_source_rgb(cr, 0.45, 0.45, 0.45);
+  set_color(cr, {0.45, 0.45, 0.45});
   cairo_set_line_width(cr, 1.0);
   const double window_dash[] = {6.0, 4.0};
   cairo_set_dash(cr, window_dash, 2, 0.0);
   for (double x : {m.settings.window_min_x_m, m.settings.window_max_x_m}) {
     const double p = std::round(f.px(x)) + 0.5;
     if (p < f.left_px || p > f.left_px + f.width_px) continue;
-    cairo_move_to(cr, p, f.top_px);
-    cairo_line_to(cr, p, f.top_px + f.height_px);
+    segment(cr, p, f.top_px, p, f.top_px + f.height_px);
     cairo_stroke(cr);
   }
   cairo_set_dash(cr, nullptr, 0, 0.0);
@@ -211,23 +195,20 @@ void draw_marks(cairo_t* cr, const Frame& f, const CrevasseMeasurement& m) {
     const Crevasse& c = m.crevasses[i];
     const double p = std::round(f.px(c.x_m)) + 0.5;
     const double top = f.py(c.surface_z_m);
-    cairo_set_source_rgb(cr, 1.0, 0.42, 0.05);
+    set_color(cr, {1.0, 0.42, 0.05});
     cairo_set_line_width(cr, 1.5);
-    cairo_move_to(cr, p, top - 12.0);
-    cairo_line_to(cr, p, top - 3.0);
+    segment(cr, p, top - 12.0, p, top - 3.0);
     cairo_stroke(cr);
     cairo_set_line_width(cr, 1.0);
     const double dash[] = {3.0, 2.0};
     cairo_set_dash(cr, dash, 2, 0.0);
-    cairo_move_to(cr, p, top);
-    cairo_line_to(cr, p, f.py(c.surface_z_m - c.depth_m));
+    segment(cr, p, top, p, f.py(c.surface_z_m - c.depth_m));
     cairo_stroke(cr);
     cairo_set_dash(cr, nullptr, 0, 0.0);
-    cairo_move_to(cr, p - 3.0, f.py(c.surface_z_m - c.depth_m));
-    cairo_line_to(cr, p + 3.0, f.py(c.surface_z_m - c.depth_m));
+    segment(cr, p - 3.0, f.py(c.surface_z_m - c.depth_m), p + 3.0, f.py(c.surface_z_m - c.depth_m));
     cairo_stroke(cr);
     if (i % label_every == 0) {
-      cairo_set_source_rgb(cr, 0.70, 0.15, 0.0);
+      set_color(cr, {0.70, 0.15, 0.0});
       show_text(cr, p, top - 14.0, std::to_string(i + 1), 0.5, 1.0);
     }
   }
@@ -251,7 +232,7 @@ void draw_title_and_legend(cairo_t* cr, int width, const ParticleSnapshot& s,
     }
   }
   if (!o.title_extra.empty()) title += "   " + o.title_extra;
-  cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
+  set_color(cr, {0.1, 0.1, 0.1});
   cairo_set_font_size(cr, 14.0);
   show_text(cr, 70.0, 12.0, title, 0.0, 0.0);
 
@@ -259,15 +240,15 @@ void draw_title_and_legend(cairo_t* cr, int width, const ParticleSnapshot& s,
   const double bar_w = 160.0, bar_h = 10.0, bx = width - 20.0 - bar_w, by = 14.0;
   for (int k = 0; k < static_cast<int>(bar_w); ++k) {
     const Rgb c = damage_colour(k / (bar_w - 1.0));
-    cairo_set_source_rgb(cr, c.r, c.g, c.b);
+    set_color(cr, {c.r, c.g, c.b});
     cairo_rectangle(cr, bx + k, by, 1.0, bar_h);
     cairo_fill(cr);
   }
-  cairo_set_source_rgb(cr, 0.3, 0.3, 0.3);
+  set_color(cr, {0.3, 0.3, 0.3});
   cairo_set_line_width(cr, 1.0);
   cairo_rectangle(cr, bx + 0.5, by + 0.5, bar_w - 1.0, bar_h - 1.0);
   cairo_stroke(cr);
-  cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
+  set_color(cr, {0.1, 0.1, 0.1});
   cairo_set_font_size(cr, 11.0);
   show_text(cr, bx - 6.0, by + 0.5 * bar_h, "damage 0", 1.0, 0.5);
   show_text(cr, bx + bar_w + 4.0, by + 0.5 * bar_h, "1", 0.0, 0.5);
@@ -337,38 +318,24 @@ SideViewImageSize write_side_view_png(const ParticleSnapshot& s, const std::file
   }
   const Frame frame{x0, z1, scale, kLeft, top_margin, plot_w, plot_h};
 
-  SurfacePtr surface(
-      cairo_image_surface_create(CAIRO_FORMAT_ARGB32, o.width_px, static_cast<int>(height)),
-      cairo_surface_destroy);
-  ContextPtr cr(cairo_create(surface.get()), cairo_destroy);
-  if (cairo_status(cr.get()) != CAIRO_STATUS_SUCCESS) {
-    throw std::runtime_error("side view: cairo could not create a " + std::to_string(o.width_px) +
-                             " px wide image (out of memory?)");
-  }
-  cairo_set_source_rgb(cr.get(), 1.0, 1.0, 1.0);
+  const canvas::SurfacePtr surface = canvas::image(o.width_px, static_cast<int>(height), "side view");
+  const canvas::ContextPtr cr = canvas::context(surface.get(), "side view");
+  set_color(cr.get(), {1.0, 1.0, 1.0});
   cairo_paint(cr.get());
-  cairo_save(cr.get());
-  cairo_rectangle(cr.get(), frame.left_px, frame.top_px, frame.width_px, frame.height_px);
-  cairo_clip(cr.get());
-  draw_bed(cr.get(), frame, s);
-  cairo_restore(cr.get());
+  {
+    const canvas::Clip clip(cr.get(), frame.left_px, frame.top_px, frame.width_px, frame.height_px);
+    draw_bed(cr.get(), frame, s);
+  }
   paint_particles(surface.get(), frame, s, criterion, o, 0.5 * (y_lo + y_hi));
-  cairo_save(cr.get());
-  cairo_rectangle(cr.get(), frame.left_px, frame.top_px, frame.width_px, frame.height_px);
-  cairo_clip(cr.get());
-  draw_bed_outline(cr.get(), frame, s);
-  if (marks) draw_marks(cr.get(), frame, *marks);
-  cairo_restore(cr.get());
+  {
+    const canvas::Clip clip(cr.get(), frame.left_px, frame.top_px, frame.width_px, frame.height_px);
+    draw_bed_outline(cr.get(), frame, s);
+    if (marks) draw_marks(cr.get(), frame, *marks);
+  }
   draw_axes(cr.get(), frame);
   if (o.show_title) draw_title_and_legend(cr.get(), o.width_px, s, o, marks);
-
-  AtomicFile file(path);
-  const cairo_status_t status = cairo_surface_write_to_png(surface.get(), file.temp_path().c_str());
-  if (status != CAIRO_STATUS_SUCCESS) {
-    throw std::runtime_error("side view: cannot write PNG '" + path.string() + "': " +
-                             cairo_status_to_string(status) + " (does the directory exist?)");
-  }
-  file.commit();
+  canvas::check(cr.get(), "side view");
+  canvas::write_png(surface.get(), path.string(), "side view");
   return {o.width_px, static_cast<int>(height)};
 }
 

@@ -5,22 +5,23 @@
 //    particle-step of each named stage of the step (Simulation::stages());
 //  * particle_B / grid_B: bytes per particle of the per-particle arrays of Particles<Dim>
 //    (capacity × element size) and of the background grid (GridNode per node);
-//  * sortstep/…: sort_step_peak_heap_B, the peak heap per particle during step 100 (a later
-//    sorting step, arrays at their steady size), against heap_B just before it;
-//  * heap_B / peak_heap_B / first_step_peak_heap_B: live heap held by the simulation after the
-//    measured steps, its peak during them, and its peak during the first step (which sorts
-//    the particles), per particle (everything: particles, grid, scratch, bed table);
-//  * allocs_per_step / alloc_B_per_step: operator new calls and bytes during the measured
-//    steps, per step. This program replaces the global operator new to count them.
+//  * sortstep/…: heap_B just before step 100 (a later sorting step, arrays at their steady
+//    size) and sort_step_peak_B, the peak per particle during it;
+//  * heap_B: heap the simulation holds after the measured steps, per particle (everything:
+//    particles, grid, scratch, bed table), from glibc's own count of bytes in use (mallinfo2);
+//  * peak_B / first_step_peak_B: the peak during the measured steps and during the first step
+//    (which sorts the particles), per particle: the heap held when they start plus what they
+//    make resident beyond what was resident then (the kernel's high-water mark VmHWM, restarted
+//    through /proc/self/clear_refs), so that a temporary buffer counts once it is touched;
+//  * heap_growth_B_per_step: heap in use after the measured steps minus before them, per step
+//    (0 when a step gives back all it takes; allocations themselves are not counted).
 #include <benchmark/benchmark.h>
 #include <malloc.h>
 #include <tbb/global_control.h>
 
-#include <atomic>
 #include <cmath>
-#include <cstdlib>
+#include <fstream>
 #include <limits>
-#include <new>
 #include <string>
 #include <vector>
 
@@ -29,62 +30,35 @@
 #include "bench/shipped_scene.hpp"
 #include "engine/simulation.hpp"
 
-namespace {
-
-// Heap accounting for every operator new/delete in the process (engine, TBB's users of
-// std containers, the benchmark library). Sizes are the allocator's usable sizes, so live
-// bytes are what the process really holds.
-std::atomic<std::int64_t> g_alloc_count{0};
-std::atomic<std::int64_t> g_alloc_bytes{0};
-std::atomic<std::int64_t> g_live_bytes{0};
-std::atomic<std::int64_t> g_peak_bytes{0};
-
-void record_alloc(void* p) {
-  const auto size = static_cast<std::int64_t>(malloc_usable_size(p));
-  g_alloc_count.fetch_add(1, std::memory_order_relaxed);
-  g_alloc_bytes.fetch_add(size, std::memory_order_relaxed);
-  const std::int64_t live = g_live_bytes.fetch_add(size, std::memory_order_relaxed) + size;
-  std::int64_t peak = g_peak_bytes.load(std::memory_order_relaxed);
-  while (live > peak &&
-         !g_peak_bytes.compare_exchange_weak(peak, live, std::memory_order_relaxed)) {
-  }
-}
-
-void record_free(void* p) {
-  if (p)
-    g_live_bytes.fetch_sub(static_cast<std::int64_t>(malloc_usable_size(p)),
-                           std::memory_order_relaxed);
-}
-
-void* counted_new(std::size_t size, std::size_t align) {
-  if (size == 0) size = 1;
-  void* p = align <= alignof(std::max_align_t)
-                ? std::malloc(size)
-                : std::aligned_alloc(align, (size + align - 1) / align * align);
-  if (!p) throw std::bad_alloc();
-  record_alloc(p);
-  return p;
-}
-
-void counted_delete(void* p) {
-  record_free(p);
-  std::free(p);
-}
-
-}  // namespace
-
-// libstdc++'s array, nothrow and sized forms forward to these four.
-void* operator new(std::size_t size) { return counted_new(size, alignof(std::max_align_t)); }
-void* operator new(std::size_t size, std::align_val_t align) {
-  return counted_new(size, static_cast<std::size_t>(align));
-}
-void operator delete(void* p) noexcept { counted_delete(p); }
-void operator delete(void* p, std::align_val_t) noexcept { counted_delete(p); }
-void operator delete(void* p, std::size_t) noexcept { counted_delete(p); }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept { counted_delete(p); }
-
 namespace crevasse::bench {
 namespace {
+
+// Bytes malloc has handed out and not had back, over all arenas and mmapped chunks.
+double heap_in_use() {
+  const struct mallinfo2 m = mallinfo2();
+  return static_cast<double>(m.uordblks + m.hblkhd);
+}
+
+// A "Vm…:" line of /proc/self/status in bytes (NaN when absent).
+double status_bytes(const std::string& key) {
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind(key + ":", 0) == 0) return 1024.0 * std::stod(line.substr(key.size() + 1));
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+// Hands freed memory back to the kernel (so that reusing it counts as touching it) and restarts
+// the resident high-water mark at the resident size. Returns that size (bytes), or NaN where the
+// mark cannot be restarted (the peaks then read NaN, not the process's lifetime peak).
+double restart_peak() {
+  malloc_trim(0);
+  std::ofstream clear_refs("/proc/self/clear_refs");
+  clear_refs << "5" << std::flush;
+  return clear_refs ? status_bytes("VmRSS") : std::numeric_limits<double>::quiet_NaN();
+}
+
+// Bytes made resident since restart_peak() returned `rss_at_restart`, at their peak.
+double resident_growth(double rss_at_restart) { return status_bytes("VmHWM") - rss_at_restart; }
 
 template <class T>
 double vector_bytes(const std::vector<T>& v) {
@@ -121,29 +95,27 @@ void step_benchmark(benchmark::State& state, Material material, int threads) {
   tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism,
                                   static_cast<std::size_t>(threads));
   const SceneConfig scene = block_scene(Dim, material);
-  const std::int64_t heap_before = g_live_bytes.load();
+  const double heap_before = heap_in_use();
   Simulation<Dim> sim(scene);
   // The first step sorts the particles (as every 100th does) while the arrays still have the
   // spare capacity of seeding: its peak is reported on its own.
-  g_peak_bytes.store(g_live_bytes.load());
+  double rss = restart_peak();
+  const double first_heap = heap_in_use() - heap_before;
   sim.step();
-  const double first_peak = static_cast<double>(g_peak_bytes.load() - heap_before);
+  const double first_growth = resident_growth(rss);
   for (int i = 1; i < kWarmupSteps; ++i) sim.step();
-  g_peak_bytes.store(g_live_bytes.load());
+  rss = restart_peak();
 
   const std::vector<StageStats> stages_before = sim.stages();
   const std::int64_t psteps_before = sim.particle_steps();
   const std::int64_t steps_before = sim.steps();
-  const std::int64_t allocs_before = g_alloc_count.load();
-  const std::int64_t alloc_bytes_before = g_alloc_bytes.load();
+  const double heap_at_start = heap_in_use();
 
   for (auto _ : state) sim.step();
 
   const double steps = static_cast<double>(sim.steps() - steps_before);
-  const double allocs = static_cast<double>(g_alloc_count.load() - allocs_before);
-  const double alloc_bytes = static_cast<double>(g_alloc_bytes.load() - alloc_bytes_before);
-  const double peak = static_cast<double>(g_peak_bytes.load() - heap_before);
-  const double heap = static_cast<double>(g_live_bytes.load() - heap_before);
+  const double heap_at_end = heap_in_use();
+  const double peak = heap_at_start - heap_before + resident_growth(rss);
   const double psteps = static_cast<double>(sim.particle_steps() - psteps_before);
   const double n = static_cast<double>(sim.particles().size());
 
@@ -156,11 +128,10 @@ void step_benchmark(benchmark::State& state, Material material, int threads) {
   }
   c["particle_B"] = particle_array_bytes(sim.particles()) / n;
   c["grid_B"] = grid_bytes(sim.particles(), scene.dx) / n;
-  c["heap_B"] = heap / n;
-  c["peak_heap_B"] = peak / n;
-  c["first_step_peak_heap_B"] = first_peak / n;
-  c["allocs_per_step"] = allocs / steps;
-  c["alloc_B_per_step"] = alloc_bytes / steps;
+  c["heap_B"] = (heap_at_end - heap_before) / n;
+  c["peak_B"] = peak / n;
+  c["first_step_peak_B"] = (first_heap + first_growth) / n;
+  c["heap_growth_B_per_step"] = (heap_at_end - heap_at_start) / steps;
   if (sim.particles().has_plastic_state()) {
     double yielded = 0.0;
     for (double e : sim.particles().eps_v_p) yielded += e > 0.0 ? 1.0 : 0.0;
@@ -168,20 +139,20 @@ void step_benchmark(benchmark::State& state, Material material, int threads) {
   }
 }
 
-// Peak heap of a later sorting step (step 100: the particles are re-sorted every 100 steps),
+// Peak memory of a later sorting step (step 100: the particles are re-sorted every 100 steps),
 // once the arrays have their steady size: the steady heap plus the sort's own temporaries.
 template <int Dim>
 void sort_step_benchmark(benchmark::State& state, const SceneConfig& scene) {
-  const std::int64_t heap_before = g_live_bytes.load();
+  const double heap_before = heap_in_use();
   Simulation<Dim> sim(scene);
   for (auto _ : state) {
     while (sim.steps() < 100) sim.step();  // steps 0..99; step 100 sorts again
-    g_peak_bytes.store(g_live_bytes.load());
-    const double steady = static_cast<double>(g_live_bytes.load() - heap_before);
+    const double steady = heap_in_use() - heap_before;
+    const double rss = restart_peak();
     sim.step();
     const double n = static_cast<double>(sim.particles().size());
     state.counters["heap_B"] = steady / n;
-    state.counters["sort_step_peak_heap_B"] = static_cast<double>(g_peak_bytes.load() - heap_before) / n;
+    state.counters["sort_step_peak_B"] = (steady + resident_growth(rss)) / n;
   }
 }
 

@@ -119,7 +119,7 @@ def main(argv):
 
     header = ["case", "particles", "M pst/s", "±", "of limit", "of limit + avg", "2T/1T", "1T M pst/CPU-s",
               "of limit (CPU)", "particle B", "grid B",
-              "heap B (peak; 1st step)", "allocs/step", "prep", "p2g", "grid", "g2p", "other"]
+              "heap B", "peak B (1st step)", "heap growth B/step", "prep", "p2g", "grid", "g2p", "other"]
     print("| " + " | ".join(header) + " |")
     print("|" + "---|" * len(header))
     for k in order:
@@ -148,19 +148,19 @@ def main(argv):
                   f"{100.0 * frac:.0f}%" if frac else "", f"{100.0 * frac_avg:.0f}%" if frac_avg else "",
                   f"{one:.2f}×" if one else "", cpu, cpu_frac]
         if material.startswith("limit"):
-            cells = common + [f"{first['state_B']:.0f}", "", "", ""]
+            cells = common + [f"{first['state_B']:.0f}", "", "", "", ""]
         else:
             cells = common + [f"{first['particle_B']:.0f}", f"{first['grid_B']:.1f}",
-                              f"{median_of(k, 'heap_B'):.0f} ({median_of(k, 'peak_heap_B'):.0f}; "
-                              f"{median_of(k, 'first_step_peak_heap_B'):.0f})",
-                              f"{median_of(k, 'allocs_per_step'):.1f}"]
+                              f"{median_of(k, 'heap_B'):.0f}",
+                              f"{median_of(k, 'peak_B'):.0f} ({median_of(k, 'first_step_peak_B'):.0f})",
+                              f"{median_of(k, 'heap_growth_B_per_step'):.0f}"]
         cells += [f"{ph[p]:.0f}" for p in ["prepare", "p2g", "grid", "g2p", "other"]]
         print("| " + " | ".join(cells) + " |")
     for name, entry in sorted(sort_steps.items()):
         dim, what = name.split("/")[1].upper(), name.split("/")[2].replace("_", " ")
         print()
         print(f"{dim} {what}, a later sorting step (step 100): heap {entry['heap_B']:.0f} B/particle "
-              f"before it, peak {entry['sort_step_peak_heap_B']:.0f} B/particle during it.")
+              f"before it, peak {entry['sort_step_peak_B']:.0f} B/particle during it.")
     print()
     print(f"{n_rounds} interleaved rounds (per round and group: the limit kernel, then the engine's "
           "cases). M pst/s: million particle-steps per second (wall clock), median over the rounds; "
@@ -171,8 +171,11 @@ def main(argv):
           "2T/1T: median over the rounds of the two-thread over the one-thread rate. 1T M pst/CPU-s: "
           "one-thread rate per CPU-second of the benchmark thread (less disturbed by other load than "
           "the wall clock). particle B: per-particle arrays of Particles<Dim>; grid B: grid nodes "
-          "(mass, intact mass, velocity); heap B: all heap the simulation holds, per particle, with "
-          "its peak during an ordinary step and during the first step (which sorts the particles). "
+          "(mass, intact mass, velocity); heap B: all heap the simulation holds, per particle (glibc's "
+          "bytes in use, mallinfo2); peak B: its peak during the measured steps and during the first "
+          "step (which sorts the particles), per particle: the heap held when they start plus what "
+          "they make resident beyond what was resident then (VmHWM); heap growth B/step: heap in use after "
+          "the measured steps minus before them, per step (0: a step gives back all it takes). "
           "prep … other: ns per particle-step of each phase (wall clock), median over the rounds.")
     return 0
 

@@ -15,8 +15,8 @@
 #include "cli/cli_common.hpp"
 #include "cli/csv_file.hpp"
 #include "engine/error.hpp"
+#include "engine/json_input.hpp"
 #include "study/case_results.hpp"
-#include "study/json_checks.hpp"
 #include "study/store.hpp"
 #include "study/study_fit.hpp"
 

@@ -9,8 +9,8 @@
 #include "cli/cli_common.hpp"
 #include "cli/csv_file.hpp"
 #include "engine/error.hpp"
+#include "engine/json_input.hpp"
 #include "study/fits_table.hpp"
-#include "study/json_checks.hpp"
 #include "study/store.hpp"
 
 namespace crevasse {

@@ -17,14 +17,14 @@
 #include "cli/export_command.hpp"
 #include "cli/fit_command.hpp"
 #include "cli/measure_command.hpp"
+#include "cli/merge_command.hpp"
 #include "cli/plot_command.hpp"
 #include "cli/run_command.hpp"
 #include "cli/status_command.hpp"
 #include "cli/study_command.hpp"
 #include "engine/error.hpp"
-#include "study/json_checks.hpp"
+#include "engine/json_input.hpp"
 #include "study/memory_reserve.hpp"
-#include "study/merge.hpp"
 
 namespace {
 

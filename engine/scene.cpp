@@ -6,10 +6,10 @@
 #include <cmath>
 #include <numbers>
 #include <set>
-#include <sstream>
 
 #include "engine/error.hpp"
 #include "engine/hencky.hpp"
+#include "engine/json_input.hpp"
 
 namespace crevasse {
 namespace {
@@ -27,33 +27,14 @@ constexpr std::pair<Effect, const char*> kEffectNames[] = {
     {Effect::downstream_drive, "downstream_drive"},
 };
 
-std::string fmt(double v) {
-  std::ostringstream o;
-  o << v;
-  return o.str();
-}
-
 // A number as docs/scene_format.md writes it: 1e5 rather than 100000, − for minus.
 std::string doc_number(double v) {
   const double a = std::abs(v);
   std::string body;
   const double e = a > 0 ? std::round(std::log10(a)) : 0;
   if (a > 0 && std::abs(e) >= 3 && a == std::pow(10.0, e)) body = "1e" + std::to_string(static_cast<int>(e));
-  else body = fmt(a);
+  else body = input_number(a);
   return (v < 0 ? "−" : "") + body;
-}
-
-[[noreturn]] void fail(const std::string& field, const std::string& what) {
-  throw InputError(field + ": " + what);
-}
-
-void check_range(const std::string& field, double v, double lo, double hi, bool lo_open = false,
-                 bool hi_open = false) {
-  const bool ok = std::isfinite(v) && (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
-  if (!ok) {
-    fail(field, "value " + fmt(v) + " is outside the allowed range " + (lo_open ? "(" : "[") +
-                    fmt(lo) + ", " + fmt(hi) + (hi_open ? ")" : "]"));
-  }
 }
 
 // Reads one JSON object, remembering which keys were used so that unknown ones are refused.
@@ -161,13 +142,9 @@ const char* name_of(E k) {
 // 'a', 'b' or 'c'
 template <class E>
 std::string allowed_names() {
-  std::string out;
-  const std::size_t n = std::size(KindNames<E>::names);
-  for (std::size_t i = 0; i < n; ++i) {
-    out += (i == 0 ? "" : i + 1 == n ? " or " : ", ");
-    out += std::string("'") + KindNames<E>::names[i].second + "'";
-  }
-  return out;
+  std::vector<std::string> names;
+  for (const auto& [v, n] : KindNames<E>::names) names.push_back(n);
+  return name_list(names, true);
 }
 
 template <class E>
@@ -342,7 +319,7 @@ const std::vector<FieldSpec>& field_table() {
 // The static ranges of the fields checked `when`.
 void check_fields(const SceneConfig& s, When when) {
   for (const auto& f : field_table())
-    if (f.when == when && f.number) check_range(f.path(), f.number(s), f.lo, f.hi, f.lo_open, f.hi_open);
+    if (f.when == when && f.number) check_range(f.path(), f.number(s), {f.lo, f.hi, f.lo_open, f.hi_open});
 }
 
 // The JSON object at a section's path ("ice.softening" → j["ice"]["softening"]).
@@ -368,9 +345,9 @@ const char* effect_name(Effect e) {
 Effect effect_from_name(const std::string& name) {
   for (const auto& [k, n] : kEffectNames)
     if (name == n) return k;
-  std::string all;
-  for (const auto& [k, n] : kEffectNames) all += std::string(all.empty() ? "" : ", ") + n;
-  fail("effects", "unknown effect '" + name + "' (allowed: " + all + ")");
+  std::vector<std::string> all;
+  for (const auto& [k, n] : kEffectNames) all.push_back(n);
+  fail("effects", "unknown effect '" + name + "' (allowed: " + name_list(all) + ")");
 }
 
 bool SceneConfig::records_gate() const {
@@ -439,7 +416,7 @@ void SceneConfig::resolve() {
   if (nonlocal_radius > 0.0 && !has(Effect::softening))
     fail("ice.softening.nonlocal_radius", "needs the 'softening' effect (it averages what softens)");
   if (nonlocal_radius > 0.0 && nonlocal_radius < dx)
-    fail("ice.softening.nonlocal_radius", "value " + fmt(nonlocal_radius) + " m is below dx; allowed 0 or [dx, 1e5] m");
+    fail("ice.softening.nonlocal_radius", "value " + input_number(nonlocal_radius) + " m is below dx; allowed 0 or [dx, 1e5] m");
   if (brittle_cap && (cap_relaxation_time > 0.0 || nonlocal_radius > 0.0))
     fail("ice.softening.brittle_cap", "drops the stress at once: not with cap_relaxation_time or nonlocal_radius");
   if (cap_relaxation_time > 0.0 && !has(Effect::plasticity))
@@ -481,25 +458,25 @@ void SceneConfig::resolve() {
     const double h = body == Body::slab ? ice_thickness : box_max[dim - 1] - box_min[dim - 1];
     settle_time = (initial_stress != InitialStress::none && has(Effect::gravity)) ? 30.0 * h / p_wave_speed() : 0.0;
   }
-  check_range("ice.settle_time", settle_time, 0.0, 1e6);
+  check_range("ice.settle_time", settle_time, {0.0, 1e6});
   if (body == Body::slab) {
     if (dx > ice_thickness / 4.0)
-      fail("numerics.dx", "value " + fmt(dx) + " is too coarse for ice.thickness " +
-                              fmt(ice_thickness) + " (need dx ≤ H_i/4 = " + fmt(ice_thickness / 4) + ")");
+      fail("numerics.dx", "value " + input_number(dx) + " is too coarse for ice.thickness " +
+                              input_number(ice_thickness) + " (need dx ≤ H_i/4 = " + input_number(ice_thickness / 4) + ")");
     if (upstream_length == 0.0) upstream_length = 5.0 * ice_thickness;
     if (downstream_length == 0.0) downstream_length = 10.0 * ice_thickness;
     if (width == 0.0) width = ice_thickness;
     if (top_margin == 0.0) top_margin = 0.5 * ice_thickness + 4.0 * dx;
     if (drive_start == DriveStart::moving) drive_ramp_time = 0.0;
     else if (drive_ramp_time == 0.0 && has(Effect::drive)) drive_ramp_time = 100.0 * upstream_length / p_wave_speed();
-    check_range("ice.upstream_length", upstream_length, 2.0 * dx, 1e7);
+    check_range("ice.upstream_length", upstream_length, {2.0 * dx, 1e7});
     // A glacier held downstream drapes the whole bed by default, up to the outflow line.
     if (has(Effect::downstream_drive) && draped_length == 0.0)
       draped_length = step_length + downstream_length - 3.0 * dx;
     // Draped ice may reach the outflow line, 3 cells before the domain's end.
-    check_range("ice.draped_length", draped_length, 0.0, step_length + downstream_length - 3.0 * dx);
-    check_range("bed.downstream_length", downstream_length, 4.0 * dx, 1e7);
-    check_range("ice.width", width, 2.0 * dx, 1e6);
+    check_range("ice.draped_length", draped_length, {0.0, step_length + downstream_length - 3.0 * dx});
+    check_range("bed.downstream_length", downstream_length, {4.0 * dx, 1e7});
+    check_range("ice.width", width, {2.0 * dx, 1e6});
     if (bed_shape != BedShape::step && bed_shape != BedShape::concave)
       fail("bed.shape", std::string("value '") + kind_name(bed_shape) + "' is not 'step' or 'concave' (body 'slab')");
     if (bed_shape == BedShape::concave && step_length <= 0)
@@ -509,9 +486,9 @@ void SceneConfig::resolve() {
       // The arc's tangent points lie lip_tangent() from the corner, on the plateau and the ramp.
       const double room = std::min(upstream_length, std::hypot(step_height, step_length));
       if (lip_tangent() > room)
-        fail("bed.lip_radius", "value " + fmt(lip_radius) + " m rounds the lip over " + fmt(lip_tangent()) +
-                                   " m each side, more than the " + fmt(room) + " m of plateau or ramp; allowed (0, " +
-                                   fmt(room / std::tan(0.5 * std::atan2(step_height, step_length))) + "] m");
+        fail("bed.lip_radius", "value " + input_number(lip_radius) + " m rounds the lip over " + input_number(lip_tangent()) +
+                                   " m each side, more than the " + input_number(room) + " m of plateau or ramp; allowed (0, " +
+                                   input_number(room / std::tan(0.5 * std::atan2(step_height, step_length))) + "] m");
     }
     const double x_end = upstream_length + step_length + downstream_length;
     domain_min = {-4.0 * dx, 0.0, -4.0 * dx};
@@ -531,23 +508,23 @@ void SceneConfig::resolve() {
     if (bed_shape != BedShape::flat && bed_shape != BedShape::none)
       fail("bed.shape", std::string("value '") + kind_name(bed_shape) + "' is not 'flat' or 'none' (body 'box')");
   }
-  check_range("run.gate_length", gate_length, 0.0, 1e9);
+  check_range("run.gate_length", gate_length, {0.0, 1e9});
   if (gate_length != 0.0) {
     if (!records_gate())
       fail("run.gate_length", "needs a slab on a 'step' or 'concave' bed with the 'plasticity' effect");
     // A piston consumes the slab behind the step; an inflow feeds it without end.
-    if (drive_boundary == DriveBoundary::piston) check_range("run.gate_length", gate_length, 0.0, upstream_length, true);
+    if (drive_boundary == DriveBoundary::piston) check_range("run.gate_length", gate_length, {0.0, upstream_length, true});
   }
-  check_range("run.gate_offset", gate_offset, 0.0, body == Body::slab ? step_length + downstream_length - 8.0 * dx : 0.0);
+  check_range("run.gate_offset", gate_offset, {0.0, body == Body::slab ? step_length + downstream_length - 8.0 * dx : 0.0});
   if (has(Effect::downstream_drive)) {
     if (body != Body::slab || !has(Effect::drive) || !has(Effect::outflow))
       fail("effects", "'downstream_drive' needs ice.body 'slab' and the 'drive' and 'outflow' effects");
     // The held cells are the last 5 before the domain's end (Simulation::kDownstreamDriveCells).
     const double reach = step_length + downstream_length - 5.0 * dx;
     if (draped_length < reach)
-      fail("ice.draped_length", "value " + fmt(draped_length) + " leaves the downstream drive without ice: " +
+      fail("ice.draped_length", "value " + input_number(draped_length) + " leaves the downstream drive without ice: " +
                                     "with 'downstream_drive' it must be at least bed.step_length + " +
-                                    "bed.downstream_length - 5 dx = " + fmt(reach));
+                                    "bed.downstream_length - 5 dx = " + input_number(reach));
   }
   if (has(Effect::basal_friction) && bed_shape == BedShape::none)
     fail("bed.shape", "'basal_friction' needs a bed");
@@ -561,10 +538,10 @@ void SceneConfig::resolve() {
   // Lattice indices are ints, and 1e9 particles are more than any machine holds.
   for (int a = 0; a < dim; ++a)
     if ((domain_max[a] - domain_min[a]) / dx > 1e6)
-      fail("numerics.dx", "value " + fmt(dx) + " gives more than 1e6 cells along axis " + std::to_string(a));
+      fail("numerics.dx", "value " + input_number(dx) + " gives more than 1e6 cells along axis " + std::to_string(a));
   const double particles = expected_particles();
   if (particles > 1e9)
-    fail("numerics.dx", "value " + fmt(dx) + " gives about " + fmt(particles) +
+    fail("numerics.dx", "value " + input_number(dx) + " gives about " + input_number(particles) +
                             " particles (limit 1e9); use a coarser dx or a smaller scene");
 }
 
@@ -627,7 +604,7 @@ void check_given_fields(const nlohmann::json& j, const SceneConfig& s) {
   if (s.has(Effect::box_walls) && s.wall_axes.empty())
     fail("effects", "'box_walls' needs at least one axis in domain.wall_axes");
   if (s.bed_shape != BedShape::flat && given(j, "bed", "z") && s.flat_bed_z != 0.0)
-    fail("bed.z", "value " + fmt(s.flat_bed_z) + " given for bed.shape '" + kind_name(s.bed_shape) +
+    fail("bed.z", "value " + input_number(s.flat_bed_z) + " given for bed.shape '" + kind_name(s.bed_shape) +
                         "'; bed.z applies to bed.shape 'flat' only (remove it)");
 
   // Coordinates without a range check in the engine's loader. Lattice indices are ints: every
@@ -635,23 +612,23 @@ void check_given_fields(const nlohmann::json& j, const SceneConfig& s) {
   const double reach = 1e6 * s.dx;
   if (s.body == Body::box) {
     for (int a = 0; a < s.dim; ++a) {
-      check_range("domain.min[" + std::to_string(a) + "]", s.domain_min[a], -reach, reach);
-      check_range("domain.max[" + std::to_string(a) + "]", s.domain_max[a], -reach, reach);
+      check_range("domain.min[" + std::to_string(a) + "]", s.domain_min[a], {-reach, reach});
+      check_range("domain.max[" + std::to_string(a) + "]", s.domain_max[a], {-reach, reach});
     }
   }
   if (s.bed_shape == BedShape::flat) {
     // The flat bed lies inside the domain and under the ice, not through it.
     const double top = s.body == Body::box ? s.box_min[z] : s.domain_max[z];
-    check_range("bed.z", s.flat_bed_z, s.domain_min[z], top);
+    check_range("bed.z", s.flat_bed_z, {s.domain_min[z], top});
   }
   for (std::size_t i = 0; i < s.velocity_boxes.size(); ++i) {
     const auto& b = s.velocity_boxes[i];
     const std::string f = "velocity_boxes[" + std::to_string(i) + "].";
     for (int a = 0; a < s.dim; ++a) {
       const std::string ax = index_suffix(a);
-      check_range(f + "min" + ax, b.min[a], -reach, reach);
-      check_range(f + "max" + ax, b.max[a], -reach, reach);
-      check_range(f + "velocity" + ax, b.velocity[a], -1e3, 1e3);
+      check_range(f + "min" + ax, b.min[a], {-reach, reach});
+      check_range(f + "max" + ax, b.max[a], {-reach, reach});
+      check_range(f + "velocity" + ax, b.velocity[a], {-1e3, 1e3});
     }
   }
 }

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The test suite under sanitizers, from the presets in CMakePresets.json:
 #   asan: AddressSanitizer + UndefinedBehaviorSanitizer (any UB aborts), build-asan,
-#         then `ctest -LE slow` (every fast test, engine, analysis and study);
-#   tsan: ThreadSanitizer, build-tsan, then the concurrent runner and CLI tests (label study);
+#         then `ctest -LE slow` (every fast test, engine, analysis, study and cli);
+#   tsan: ThreadSanitizer, build-tsan, then the concurrent runner and CLI tests (labels study
+#         and cli);
 #   asan-ci, tsan-ci: CI's subsets (.ci/run; docs/reliability.md, "Sanitizers"), built in the
 #         same folders with only the programs they run.
 # A report makes the test fail; the ctest logs are in build-<preset>/Testing/Temporary/.
@@ -19,8 +20,8 @@ for p in $presets; do
   config=${p%-ci}
   case $p in
     asan) targets=() ;;  # everything
-    asan-ci) targets=(--target crevasse test_analysis test_study) ;;
-    tsan | tsan-ci) targets=(--target crevasse test_study) ;;
+    asan-ci) targets=(--target crevasse test_analysis test_study test_cli) ;;
+    tsan | tsan-ci) targets=(--target crevasse test_study test_cli) ;;
     *) echo "sanitize.sh: unknown preset $p (asan, tsan, asan-ci, tsan-ci)"; exit 2 ;;
   esac
   echo "== $p: configure and build (build-$config, -j$jobs)"

@@ -4,7 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "engine/error.hpp"
-#include "study/json_checks.hpp"
+#include "engine/json_input.hpp"
 
 namespace crevasse {
 

@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "engine/error.hpp"
-#include "study/json_checks.hpp"
+#include "engine/json_input.hpp"
 #include "study/scene_file.hpp"
 #include "study/study_fit.hpp"
 
@@ -20,11 +20,10 @@ std::string where(const std::string& path, std::size_t k, const std::string& fie
 }
 
 double positive_number(const json& e, const std::string& key, const std::string& at) {
-  if (!e.contains(key) || !e[key].is_number())
-    throw InputError(at + ": needs a number in (0, 1e6]");
+  const Range allowed{0.0, 1e6, true, false};
+  if (!e.contains(key) || !e[key].is_number()) fail(at, "needs a number in " + allowed.text());
   const double v = e[key].get<double>();
-  if (!std::isfinite(v) || v <= 0.0 || v > 1e6)
-    throw InputError(at + ": value " + short_number(v) + " is outside the allowed range (0, 1e6]");
+  check_range(at, v, allowed);
   return v;
 }
 

@@ -1,8 +1,8 @@
 #pragma once
-// `crevasse merge OUT.db IN1.db IN2.db ...`: combines the databases of one study's shards (or
-// of repeated runs) into one. A case stored in several inputs is kept once; a finished case
-// beats a pending one; two finished copies with different results (result_hash) are a
-// conflict: the first is kept and the conflict reported.
+// Combines the databases of one study's shards (or of repeated runs) into one, for
+// `crevasse merge` (cli/merge_command.cpp). A case stored in several inputs is kept once; a
+// finished case beats a pending one; two finished copies with different results (result_hash)
+// are a conflict: the first is kept and the conflict reported.
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -20,8 +20,5 @@ struct MergeReport {
 // Throws InputError when an input is missing, is OUT itself, or holds another study.
 MergeReport merge_databases(const std::filesystem::path& out,
                             const std::vector<std::filesystem::path>& inputs);
-
-// The CLI command: prints the report; returns 0, or 1 when there were conflicts.
-int merge_command(const std::string& out, const std::vector<std::string>& inputs);
 
 }  // namespace crevasse

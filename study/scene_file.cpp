@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "engine/error.hpp"
-#include "study/json_checks.hpp"
+#include "engine/json_input.hpp"
 
 namespace crevasse {
 

@@ -11,8 +11,8 @@
 
 #include "analysis/crevasse_measure.hpp"
 #include "engine/error.hpp"
+#include "engine/json_input.hpp"
 #include "study/case_hash.hpp"
-#include "study/json_checks.hpp"
 #include "study/scene_file.hpp"
 
 namespace crevasse {
@@ -22,31 +22,6 @@ using nlohmann::json;
 using nlohmann::ordered_json;
 
 constexpr std::size_t kMaxCases = 100000;
-
-std::string fmt(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.10g", v);
-  return buf;
-}
-
-[[noreturn]] void fail(const std::string& field, const std::string& what) {
-  throw InputError(field + ": " + what);
-}
-
-struct Range {
-  double lo, hi;
-  bool lo_open, hi_open;
-  std::string text() const {
-    return std::string(lo_open ? "(" : "[") + fmt(lo) + ", " + fmt(hi) + (hi_open ? ")" : "]");
-  }
-  bool contains(double v) const {
-    return std::isfinite(v) && (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
-  }
-};
-
-void check_range(const std::string& field, double v, const Range& r) {
-  if (!r.contains(v)) fail(field, "value " + fmt(v) + " is outside the allowed range " + r.text());
-}
 
 // Allowed range of each named study parameter.
 std::optional<Range> named_range(const std::string& name) {
@@ -95,9 +70,8 @@ const std::map<std::string, std::string>& named_targets() {
 }
 
 std::string allowed_names() {
-  std::string s;
-  for (const char* n : kStudyParameterNames) s += std::string(s.empty() ? "" : ", ") + n;
-  return s + " or a JSON pointer into the scene such as /ice/density";
+  return name_list({std::begin(kStudyParameterNames), std::end(kStudyParameterNames)}) +
+         " or a JSON pointer into the scene such as /ice/density";
 }
 
 bool is_pointer(const std::string& name) { return !name.empty() && name[0] == '/'; }
@@ -235,9 +209,9 @@ std::vector<json> expand_axis(const json& spec, const std::string& field) {
   if (!std::isfinite(a) || !std::isfinite(b)) fail(f, "bounds must be finite");
   if (n < 1 || n > 10000)
     fail(f, "count " + std::to_string(n) + " is outside the allowed range [1, 10000]");
-  if (n == 1 && a != b) fail(f, "count 1 needs first == last (" + fmt(a) + " ≠ " + fmt(b) + ")");
+  if (n == 1 && a != b) fail(f, "count 1 needs first == last (" + input_number(a) + " ≠ " + input_number(b) + ")");
   if (log && (a <= 0 || b <= 0))
-    fail(f, "bound " + fmt(a <= 0 ? a : b) +
+    fail(f, "bound " + input_number(a <= 0 ? a : b) +
                 " is not allowed: log ranges need both bounds in (0, inf)");
   std::vector<json> out;
   for (std::int64_t i = 0; i < n; ++i) {
@@ -279,8 +253,8 @@ analysis::MeasureSettings measure_settings_from_json(const json& j) {
   opt("window_min_x_m", s.window_min_x_m, {-1e9, 1e9, false, false});
   opt("window_max_x_m", s.window_max_x_m, {-1e9, 1e9, false, false});
   if (s.window_min_x_m && s.window_max_x_m && *s.window_max_x_m <= *s.window_min_x_m)
-    fail("measurement.window_max_x_m", "value " + fmt(*s.window_max_x_m) +
-                                           " must exceed window_min_x_m " + fmt(*s.window_min_x_m));
+    fail("measurement.window_max_x_m", "value " + input_number(*s.window_max_x_m) +
+                                           " must exceed window_min_x_m " + input_number(*s.window_min_x_m));
   num("window_margin_over_h", s.window_margin_over_h, {0.0, 100.0, false, false});
   num("resolution_floor_over_dx", s.resolution_floor_over_dx, {0.0, 100.0, false, false});
   if (o.contains("spacing_rule")) {
@@ -502,7 +476,7 @@ void apply_named_parameters(json& scene, std::map<std::string, double>& named, c
     const double rho = number_at(scene, "/ice/density", defaults.density);
     const double g = number_at(scene, "/gravity/g", defaults.gravity);
     if (!(g > 0))
-      fail(where, std::string(name) + " needs gravity.g > 0 (it is relative to ρ_i g H_i), got g = " + fmt(g));
+      fail(where, std::string(name) + " needs gravity.g > 0 (it is relative to ρ_i g H_i), got g = " + input_number(g));
     scene["ice"][field] = stress_from_overburden_ratio(named[name], rho, g, h_i);
   }
   // q_y = k·c: a material constant k keeps Π the only strength group (docs/model.md), where a
@@ -526,7 +500,7 @@ void apply_named_parameters(json& scene, std::map<std::string, double>& named, c
   if (has("width_ratio")) {
     const double dim = number_at(scene, "/dim", defaults.dim);
     if (dim != 3)
-      fail(where, "width_ratio applies to 3D scenes only; this case has dim " + fmt(dim));
+      fail(where, "width_ratio applies to 3D scenes only; this case has dim " + input_number(dim));
     scene["ice"]["width"] = named["width_ratio"] * h_i;
   }
   if (has("front_past_step_ratio"))

@@ -11,7 +11,7 @@
 #include <random>
 #include <thread>
 
-#include "../study_test_support.hpp"
+#include "../../study/study_test_support.hpp"
 
 namespace crevasse {
 namespace {

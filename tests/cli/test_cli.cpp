@@ -16,7 +16,7 @@
 #include <thread>
 #include <vector>
 
-#include "study_test_support.hpp"
+#include "../study/study_test_support.hpp"
 
 namespace crevasse {
 namespace {

@@ -17,7 +17,7 @@
 #include "analysis/measurement_io.hpp"
 #include "study/field_observations.hpp"
 #include "study/fits_table.hpp"
-#include "study_test_support.hpp"
+#include "../study/study_test_support.hpp"
 
 namespace crevasse {
 namespace {

@@ -15,7 +15,7 @@
 
 #include "../analysis/synthetic_slab.hpp"
 #include "study/engine_case.hpp"
-#include "study_test_support.hpp"
+#include "../study/study_test_support.hpp"
 
 namespace crevasse {
 namespace {

@@ -17,7 +17,7 @@
 
 #include <sqlite3.h>
 
-#include "study_test_support.hpp"
+#include "../study/study_test_support.hpp"
 
 namespace crevasse {
 namespace {

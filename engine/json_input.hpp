@@ -1,5 +1,6 @@
 #pragma once
-// Checks shared by the JSON inputs of the study layer (study files, field observation files).
+// What every JSON input (scene, study and observation files, stored JSON) shares: one-line
+// refusals naming the field, one number format, ranges, name lists, and the parser's limits.
 #include <cstddef>
 #include <initializer_list>
 #include <set>
@@ -12,6 +13,27 @@
 
 namespace crevasse {
 
+// Throws InputError "<field>: <what>".
+[[noreturn]] void fail(const std::string& field, const std::string& what);
+
+// A number as input messages write it: up to 10 significant digits, so that a value just
+// outside a range never prints as its bound.
+std::string input_number(double v);
+
+// An interval, closed unless marked open; infinite and NaN values are never inside.
+struct Range {
+  double lo, hi;
+  bool lo_open = false, hi_open = false;
+  bool contains(double v) const;
+  std::string text() const;  // "[lo, hi)"
+};
+
+// fail(field, "value v is outside the allowed range [lo, hi]") unless r contains v.
+void check_range(const std::string& field, double v, const Range& r);
+
+// "a, b, c", or with `quoted_or` "'a', 'b' or 'c'".
+std::string name_list(const std::vector<std::string>& names, bool quoted_or = false);
+
 // Every key of the JSON object `obj` must be one of `allowed`; otherwise InputError
 // "<where>.<key>: unknown key (allowed: a, b, ...)" (a typo never silently falls back to a
 // default). J is nlohmann::json or nlohmann::ordered_json.
@@ -22,21 +44,15 @@ void refuse_unknown_keys(const J& obj, const std::string& where,
     bool ok = false;
     for (const char* a : allowed) ok = ok || it.key() == a;
     if (!ok) {
-      std::string list;
-      for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
-      throw InputError((where.empty() ? it.key() : where + "." + it.key()) +
-                       ": unknown key (allowed: " + list + ")");
+      fail(where.empty() ? it.key() : where + "." + it.key(),
+           "unknown key (allowed: " + name_list({allowed.begin(), allowed.end()}) + ")");
     }
   }
 }
 
 // `text` with control characters (terminal escapes, newlines) shown as '?', for messages that
 // echo user input.
-inline std::string printable(std::string text) {
-  for (char& c : text)
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
-  return text;
-}
+std::string printable(std::string text);
 
 // Deepest nesting of arrays and objects any input may have. The shipped files need 4; a limit
 // far below what exhausts the stack makes a hostile file a one-line refusal, not a crash.
@@ -95,12 +111,6 @@ J parse_json_input(const std::string& text, const std::string& source) {
 
 // JSON a study database holds, under the same limits; a value that breaks them, or is not JSON,
 // comes back discarded (is_discarded()) for the caller to skip or refuse.
-inline nlohmann::json parse_stored_json(const std::string& text) {
-  try {
-    return parse_json_input<nlohmann::json>(text, "stored JSON");
-  } catch (const InputError&) {
-    return nlohmann::json(nlohmann::json::value_t::discarded);
-  }
-}
+nlohmann::json parse_stored_json(const std::string& text);
 
 }  // namespace crevasse

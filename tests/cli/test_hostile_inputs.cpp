@@ -11,9 +11,9 @@
 #include <set>
 #include <thread>
 
-#include "study/json_checks.hpp"
+#include "engine/json_input.hpp"
 #include "study/store.hpp"
-#include "study_test_support.hpp"
+#include "../study/study_test_support.hpp"
 
 namespace crevasse {
 namespace {

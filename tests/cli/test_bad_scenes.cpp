@@ -10,7 +10,7 @@
 #include <set>
 #include <sstream>
 
-#include "study_test_support.hpp"
+#include "../study/study_test_support.hpp"
 
 namespace crevasse {
 namespace {
@@ -138,7 +138,7 @@ TEST(BadStudies, ExistingDatabaseIsByteForByteUnchanged) {
     nlohmann::json s = {{"name", "keep"}, {"base_scene", (kCorpus / file).string()}};
     studies.emplace_back(s.dump(), field);
   }
-  // ... and study-level defects the loader tests (test_study_file.cpp) do not cover: inputs
+  // ... and study-level defects the loader tests (tests/study/test_study_file.cpp) do not cover: inputs
   // that reached the store or escaped as other exceptions before the fuzzer found them.
   const std::string scene = test::tiny_scene(20).dump();
   const std::vector<std::pair<std::string, std::string>> more = {
