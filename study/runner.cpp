@@ -248,12 +248,11 @@ class StudyRun {
     const auto status = store_.statuses();
     for (const StudyCase* c : scope) {
       const std::string& st = status.at(c->case_id);
-      if (!selected(c)) continue;
       if (st == "done")
         ++report_.already_done;
       else if (st == "failed" && !opt_.retry_failed)
         ++report_.already_failed;
-      else
+      else if (selected(c))
         todo_.push_back(c);
     }
     if (!opt_.case_function) check_memory();  // before the session: the cases stay pending

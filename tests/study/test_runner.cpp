@@ -108,10 +108,18 @@ TEST(Runner, OnlyTheChosenCasesRunAndTheOthersStayPending) {
   const std::string order =
       "SELECT group_concat(status, ',') FROM (SELECT status FROM cases ORDER BY case_index)";
   EXPECT_EQ(test::dump_rows(dir / "s.db", order).at(0), "pending,done,pending,done,pending");
+  // Progress counts every finished case, chosen or not.
+  ran.clear();
+  o.only_cases = {0};
+  const RunnerReport second = run_study(study, o);
+  EXPECT_EQ(second.already_done, 2u);
+  EXPECT_EQ(second.done, 1u);
+  EXPECT_EQ(ran, (std::set<std::size_t>{0}));
   // The next session without a choice runs the rest, not the chosen cases again.
   ran.clear();
-  run_study(study, fake_options(dir / "s.db", fn));
-  EXPECT_EQ(ran, (std::set<std::size_t>{0, 2, 4}));
+  const RunnerReport third = run_study(study, fake_options(dir / "s.db", fn));
+  EXPECT_EQ(third.already_done, 3u);
+  EXPECT_EQ(ran, (std::set<std::size_t>{2, 4}));
   EXPECT_EQ(test::dump_rows(dir / "s.db", order).at(0), "done,done,done,done,done");
 }
 
