@@ -14,59 +14,23 @@
 
 #include "engine/scene.hpp"
 #include "engine/simulation.hpp"
+#include "engine/state_hash.hpp"
 
 namespace {
-
-std::uint64_t fnv1a(const void* data, std::size_t bytes, std::uint64_t h = 1469598103934665603ull) {
-  const auto* p = static_cast<const unsigned char*>(data);
-  for (std::size_t i = 0; i < bytes; ++i) {
-    h ^= p[i];
-    h *= 1099511628211ull;
-  }
-  return h;
-}
-
-template <class T>
-std::uint64_t hash_array(const std::vector<T>& a) {
-  return fnv1a(a.data(), a.size() * sizeof(T));
-}
 
 template <int Dim>
 int run(const crevasse::SceneConfig& scene, long steps) {
   crevasse::Simulation<Dim> sim(scene);
   sim.settle();
   for (long s = 0; s < steps; ++s) sim.step();
-  const auto& P = sim.particles();
-  std::uint64_t all = 1469598103934665603ull;
-  const auto show = [&](const char* name, std::uint64_t h) {
-    std::printf("%-8s %016llx\n", name, static_cast<unsigned long long>(h));
-    all = fnv1a(&h, sizeof h, all);
-  };
-  show("x", hash_array(P.x));
-  show("v", hash_array(P.v));
-  show("C", hash_array(P.C));
-  show("F_e", hash_array(P.F_e));
-  show("tau", hash_array(P.tau));
-  show("mass", hash_array(P.mass));
-  show("eps_v_p", hash_array(P.eps_v_p));
-  const double t = sim.time();
-  show("time", fnv1a(&t, sizeof t));
-  long damaged = 0;
-  for (double e : P.eps_v_p) damaged += e > 0.0;
-  std::printf("particles %zu, steps %lld, t = %.6f s, damaged %ld\nall      %016llx\n", P.size(),
-              static_cast<long long>(sim.steps()), t, damaged, static_cast<unsigned long long>(all));
-  // What the state arrays do not hold: the gate's records (archive included, through the
-  // snapshot) and the read-outs, so that moving those parts of the engine is checked too.
-  const crevasse::ParticleSnapshot snap = sim.snapshot();
-  std::uint64_t gate = hash_array(snap.gate_x_ref);
-  gate = fnv1a(snap.gate_z_ref.data(), snap.gate_z_ref.size() * sizeof(double), gate);
-  gate = fnv1a(snap.gate_eps_v_p.data(), snap.gate_eps_v_p.size() * sizeof(double), gate);
-  const double reads[] = {snap.gate_passed_length_m, sim.removed_mass(), sim.inflow_mass(),
-                          sim.total_mass(), sim.kinetic_energy(), sim.gravitational_potential_energy(),
-                          sim.cap_dissipated_energy(), sim.max_yield_violation(), sim.front_x(),
-                          sim.ice_front_x(), sim.max_speed(), sim.last_dt()};
-  std::printf("gate     %016llx (%zu records)\nreadouts %016llx\n", static_cast<unsigned long long>(gate),
-              snap.gate_eps_v_p.size(), static_cast<unsigned long long>(fnv1a(reads, sizeof reads)));
+  const crevasse::StateHash h = crevasse::state_hash(sim);
+  for (const auto& [name, value] : h.parts)
+    std::printf("%-8s %016llx\n", name.c_str(), static_cast<unsigned long long>(value));
+  std::printf("particles %zu, steps %lld, t = %.6f s, damaged %ld\nall      %016llx\n",
+              sim.particles().size(), static_cast<long long>(sim.steps()), sim.time(), h.damaged,
+              static_cast<unsigned long long>(h.all));
+  std::printf("gate     %016llx (%zu records)\nreadouts %016llx\n", static_cast<unsigned long long>(h.gate),
+              h.gate_records, static_cast<unsigned long long>(h.readouts));
   return 0;
 }
 
