@@ -8,6 +8,7 @@
 #include <mutex>
 #include <set>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "engine/error.hpp"
@@ -27,6 +28,17 @@ RunnerOptions fake_options(const std::filesystem::path& db, CaseFunction f, int 
   o.case_function = std::move(f);
   return o;
 }
+
+// The cases a case function was called for, from concurrent jobs.
+struct CallLog {
+  std::mutex m;
+  std::multiset<std::size_t> calls;
+  void record(std::size_t index) {
+    std::lock_guard lock(m);
+    calls.insert(index);
+  }
+  std::multiset<std::size_t> take() { return std::exchange(calls, {}); }
+};
 
 TEST(Runner, AFailingMiddleCaseIsRecordedAndTheOthersComplete) {
   test::ScratchDir dir("runner");
@@ -93,33 +105,29 @@ TEST(Runner, FailFastStopsAtTheFirstFailureAndLeavesTheRestPending) {
 TEST(Runner, OnlyTheChosenCasesRunAndTheOthersStayPending) {
   test::ScratchDir dir("runner");
   const Study study = test::parse(test::tiny_study(5));
-  std::mutex m;
-  std::set<std::size_t> ran;
+  CallLog log;
   auto fn = [&](const StudyCase& c, CaseContext&) {
-    std::lock_guard lock(m);
-    ran.insert(c.index);
+    log.record(c.index);
     return test::fake_outcome(c);
   };
   RunnerOptions o = fake_options(dir / "s.db", fn);
   o.only_cases = parse_case_list("3,1", study.cases.size());
   const RunnerReport r = run_study(study, o);
   EXPECT_EQ(r.done, 2u);
-  EXPECT_EQ(ran, (std::set<std::size_t>{1, 3}));
+  EXPECT_EQ(log.take(), (std::multiset<std::size_t>{1, 3}));
   const std::string order =
       "SELECT group_concat(status, ',') FROM (SELECT status FROM cases ORDER BY case_index)";
   EXPECT_EQ(test::dump_rows(dir / "s.db", order).at(0), "pending,done,pending,done,pending");
   // Progress counts every finished case, chosen or not.
-  ran.clear();
   o.only_cases = {0};
   const RunnerReport second = run_study(study, o);
   EXPECT_EQ(second.already_done, 2u);
   EXPECT_EQ(second.done, 1u);
-  EXPECT_EQ(ran, (std::set<std::size_t>{0}));
+  EXPECT_EQ(log.take(), (std::multiset<std::size_t>{0}));
   // The next session without a choice runs the rest, not the chosen cases again.
-  ran.clear();
   const RunnerReport third = run_study(study, fake_options(dir / "s.db", fn));
   EXPECT_EQ(third.already_done, 3u);
-  EXPECT_EQ(ran, (std::set<std::size_t>{2, 4}));
+  EXPECT_EQ(log.take(), (std::multiset<std::size_t>{2, 4}));
   EXPECT_EQ(test::dump_rows(dir / "s.db", order).at(0), "done,done,done,done,done");
 }
 
@@ -251,13 +259,10 @@ TEST(Runner, CasesRunConcurrentlyUpToJobs) {
 TEST(Runner, FinishedCasesAreNeverRunAgain) {
   test::ScratchDir dir("runner");
   const Study study = test::parse(test::tiny_study(4));
-  std::mutex m;
-  std::multiset<std::size_t> calls;
+  CallLog log;
+  const std::multiset<std::size_t>& calls = log.calls;
   auto fn = [&](const StudyCase& c, CaseContext&) {
-    {
-      std::lock_guard lock(m);
-      calls.insert(c.index);
-    }
+    log.record(c.index);
     if (c.index == 3) throw SimulationError("unstable");
     return test::fake_outcome(c);
   };
