@@ -39,6 +39,22 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
     }
   }
   const auto wall_now = [&] { return std::chrono::duration<double>(clock::now() - t0).count(); };
+  // The summary of the state the run is in: at its stop, and at each gate mark.
+  const auto summarize = [&](RunSummary& o) {
+    o.steps = sim.steps();
+    o.particle_steps = sim.particle_steps();
+    o.return_map_evaluations = sim.return_map_evaluations();
+    o.sim_time_s = sim.time();
+    o.final_mass = sim.total_mass();
+    o.removed_mass = sim.removed_mass();
+    o.inflow_mass = sim.inflow_mass();
+    o.final_particles = sim.particles().size();
+    o.final_snapshot = sim.snapshot();
+    o.final_ice_front_x = sim.ice_front_x();
+    o.stage_seconds = nlohmann::json::object();
+    for (const auto& s : sim.stages()) o.stage_seconds[s.name] = {{"seconds", s.seconds}, {"calls", s.calls}};
+    o.wall_s = wall_now();
+  };
   double last_checkpoint_wall = 0.0;
   // A checkpoint that cannot be written costs only the time it would have saved.
   auto save_checkpoint = [&] {
@@ -99,6 +115,21 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
     stall.ramp_s = scene.drive_ramp_time;
   }
 
+  std::vector<double> marks = obs ? obs->gate_marks() : std::vector<double>();
+  std::sort(marks.begin(), marks.end());
+  // A resumed run reached these before its checkpoint was written, and called them then.
+  std::size_t next_mark = 0;
+  while (next_mark < marks.size() && marks[next_mark] <= sim.gate_passed_length() && out.resumed_from_time_s >= 0.0)
+    ++next_mark;
+  const auto call_marks = [&] {
+    while (next_mark < marks.size() && sim.gate_passed_length() >= marks[next_mark]) {
+      RunSummary at = out;
+      at.stop_reason = "gate_length";
+      summarize(at);
+      obs->on_gate_mark(marks[next_mark++], at);
+    }
+  };
+
   // The settling phase is polled between its steps like the run: time limit, checkpoints and
   // cancellation, so that neither a signal nor the limit waits for it to end.
   {
@@ -139,6 +170,7 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
     if (scene.max_steps > 0 && sim.steps() >= scene.max_steps) { out.stop_reason = "max_steps"; break; }
     if (sim.particles().size() == 0) { out.stop_reason = "no_ice_left"; break; }
     sim.step();
+    call_marks();
     maybe_output();
     if (snap_interval > 0.0 && sim.time() + 1e-12 >= next_snap) {
       obs->on_snapshot(sim.snapshot());
@@ -178,21 +210,10 @@ RunSummary run_dim(const SceneConfig& scene, RunObserver* obs) {
     std::error_code ec;
     std::filesystem::remove(checkpoint, ec);
   }
-  out.steps = sim.steps();
-  out.particle_steps = sim.particle_steps();
-  out.return_map_evaluations = sim.return_map_evaluations();
-  out.sim_time_s = sim.time();
-  out.final_mass = sim.total_mass();
-  out.removed_mass = sim.removed_mass();
-  out.inflow_mass = sim.inflow_mass();
-  out.final_particles = sim.particles().size();
-  out.final_snapshot = sim.snapshot();
-  out.final_ice_front_x = sim.ice_front_x();
+  summarize(out);
   // The last state is always among the snapshots, unless the last interval just wrote it.
   if (obs && scene.vtu_interval > 0 && last_output_time < sim.time())
     obs->on_output(out.final_snapshot, output_index++);
-  for (const auto& s : sim.stages()) out.stage_seconds[s.name] = {{"seconds", s.seconds}, {"calls", s.calls}};
-  out.wall_s = std::chrono::duration<double>(clock::now() - t0).count();
   return out;
 }
 

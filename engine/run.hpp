@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "engine/scene.hpp"
 #include "engine/snapshot.hpp"
@@ -22,6 +23,8 @@ struct RunProgress {
   double front_x_m = 0.0;
   double wall_s = 0.0;
 };
+
+struct RunSummary;
 
 class RunObserver {
  public:
@@ -48,6 +51,13 @@ class RunObserver {
   // known, the checkpoint being of format 2). This is the one way the earlier wall time leaves
   // the run: it reaches the observer also when the run then fails or runs out of time.
   virtual void on_resumed(double /*fraction_done*/, std::optional<double> /*earlier_wall_s*/) {}
+  // Gate marks [m of ice through the gate, ascending]: when the passed length first reaches one,
+  // on_gate_mark gets the run's summary as if it had stopped there, which is bit for bit what a
+  // run with run.gate_length = that mark stops with (one run serves a shorter protocol too).
+  // Marks are checked after each step, before any checkpoint of that step's state is written, so
+  // a resumed run calls none twice: marks already reached when it resumes are not called.
+  virtual std::vector<double> gate_marks() const { return {}; }
+  virtual void on_gate_mark(double /*mark_m*/, const RunSummary& /*as_if_stopped*/) {}
   // Return true to stop the run early (cancellation); the run then ends with "cancelled".
   virtual bool cancelled() { return false; }
   // Wall seconds between on_progress calls.

@@ -3,6 +3,9 @@
 
     python3 scripts/over_time_table.py results/numerics/initiation_settling_800.db [--cases 0,1]
         [--every 0.1] [--tolerance-cracks 1] [--tolerance-spacing 0.0125]
+    python3 scripts/over_time_table.py DB.checkpoints/CASE.ckpt.over_time.json --thickness 800
+
+The second form reads a running case's rows so far (kept beside its checkpoint).
 
 For each done (or checkpointed-then-done) case the measurement stored every measure_interval_s in
 result_json.extra.over_time is printed as a table: simulated time, ice pushed through the gate in
@@ -47,19 +50,37 @@ def median(r):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("db")
+    ap.add_argument("db", help="study database, or a running case's CASE.ckpt.over_time.json")
+    ap.add_argument("--thickness", type=float, default=0.0, help="H_i [m], with an over_time.json file")
     ap.add_argument("--cases", default="", help="case indices, comma-separated (default all)")
     ap.add_argument("--every", type=float, default=0.0, help="print one row per this many H_i pushed")
     ap.add_argument("--tolerance-cracks", type=int, default=1)
     ap.add_argument("--tolerance-spacing", type=float, default=0.0125)
     ap.add_argument("--spread", type=float, default=0.0, help="replica spread of spacing/depth over H_i")
     a = ap.parse_args()
+    if a.db.endswith(".json"):
+        if a.thickness <= 0:
+            sys.exit("over_time_table: give --thickness (H_i in m) with an over_time.json file")
+        try:
+            rows = [(0, a.thickness, float("nan"), 0, json.dumps({"extra": {"over_time": json.load(open(a.db))}}))]
+        except (OSError, ValueError) as e:
+            sys.exit(f"over_time_table: cannot read {a.db}: {e}")
+    else:
+        rows = read_db(a.db)
+    show(rows, a)
+
+
+def read_db(path):
     try:
-        con = sqlite3.connect(f"file:{a.db}?mode=ro", uri=True)
+        con = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
         rows = con.execute("SELECT case_index, thickness_m, cohesion_ratio, seed, result_json FROM cases "
                            "WHERE status = 'done' ORDER BY case_index").fetchall()
     except sqlite3.Error as e:
-        sys.exit(f"over_time_table: cannot read {a.db}: {e}")
+        sys.exit(f"over_time_table: cannot read {path}: {e}")
+    return rows
+
+
+def show(rows, a):
     wanted = {int(x) for x in a.cases.split(",") if x.strip()}
     tol_len = max(a.tolerance_spacing, a.spread)
     for idx, h, pi, seed, rj in rows:

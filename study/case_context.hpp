@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "analysis/crevasse_measure.hpp"
 #include "study/study_file.hpp"
@@ -86,6 +87,10 @@ class CaseContext {
   // (Study::measure_interval_s).
   void set_measure_interval(double s) { measure_interval_s_ = s; }
   double measure_interval_s() const { return measure_interval_s_; }
+  // Lengths of ice through the gate, in H_i, at which the case also keeps its particles
+  // (Study::gate_mark_ratios; only where it keeps its final particles).
+  void set_gate_mark_ratios(std::vector<double> r) { gate_mark_ratios_ = std::move(r); }
+  const std::vector<double>& gate_mark_ratios() const { return gate_mark_ratios_; }
   // Where the case keeps its final particles (case_NNN_particles.bin; empty: nowhere).
   void set_particles_dir(std::filesystem::path dir) { particles_dir_ = std::move(dir); }
   const std::filesystem::path& particles_dir() const { return particles_dir_; }
@@ -103,6 +108,7 @@ class CaseContext {
   std::filesystem::path views_dir_;
   std::filesystem::path particles_dir_;
   double measure_interval_s_ = 0.0;
+  std::vector<double> gate_mark_ratios_;
   std::function<void(const std::string&)> warn_;
 };
 

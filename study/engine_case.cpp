@@ -10,6 +10,7 @@
 #include "engine/error.hpp"
 #include "engine/particle_file.hpp"
 #include "engine/run.hpp"
+#include "study/case_hash.hpp"
 #include "study/case_views.hpp"
 #include "study/field_over_time.hpp"
 #include "study/memory_reserve.hpp"
@@ -18,10 +19,37 @@
 namespace crevasse {
 namespace {
 
+// What a run's result and run records hold of its summary, at its stop or at a gate mark.
+nlohmann::json result_extra_of(const RunSummary& r) {
+  return {{"initial_mass_kg", r.initial_mass},    {"final_mass_kg", r.final_mass},
+          {"removed_mass_kg", r.removed_mass},    {"inflow_mass_kg", r.inflow_mass},
+          {"initial_particles", r.initial_particles},
+          {"final_particles", r.final_particles}, {"return_map_evaluations", r.return_map_evaluations}};
+}
+
+// The whole run's wall time, its earlier sittings included (the checkpoint carries them);
+// stage_seconds are this sitting's. A format 2 checkpoint did not keep them: then the wall
+// times stored are this sitting's alone, and run_json says so.
+nlohmann::json run_json_of(const RunSummary& r, std::optional<double> earlier) {
+  const double engine_wall_s = r.wall_s + earlier.value_or(0.0);
+  nlohmann::json run = {{"engine_wall_s", engine_wall_s},
+                        {"sitting_wall_s", r.wall_s},
+                        {"resumed_from_time_s", r.resumed_from_time_s},
+                        {"stage_seconds", r.stage_seconds},
+                        {"particle_steps_per_s",
+                         engine_wall_s > 0 ? static_cast<double>(r.particle_steps) / engine_wall_s : 0.0}};
+  if (!earlier) {
+    run["earlier_wall_unknown"] = true;
+    run["particle_steps_per_s"] = nullptr;  // all the steps over one sitting's wall
+  }
+  return run;
+}
+
 class CaseObserver : public RunObserver {
  public:
-  explicit CaseObserver(CaseContext& ctx)
-      : ctx_(ctx),
+  CaseObserver(const StudyCase& study_case, CaseContext& ctx)
+      : case_(study_case),
+        ctx_(ctx),
         over_time_(ctx.checkpoint_file().empty() || ctx.measure_interval_s() <= 0
                        ? std::filesystem::path()
                        : over_time_file(ctx.checkpoint_file())) {}
@@ -34,6 +62,18 @@ class CaseObserver : public RunObserver {
     }
   }
   const FieldOverTime& over_time() const { return over_time_; }
+  // Gate marks only where the case keeps particles and its scene has a gate; a mark at or past
+  // the case's own stop is its final state, kept as such.
+  std::vector<double> gate_marks() const override {
+    std::vector<double> marks;
+    if (ctx_.particles_dir().empty() || !case_.scene.records_gate()) return marks;
+    for (double ratio : ctx_.gate_mark_ratios()) {
+      const double at = ratio * case_.scene.ice_thickness;
+      if (case_.scene.gate_length <= 0.0 || at < case_.scene.gate_length) marks.push_back(at);
+    }
+    return marks;
+  }
+  void on_gate_mark(double mark_m, const RunSummary& at) override { keep_gate_mark(mark_m, at); }
   void on_progress(const RunProgress& p) override { ctx_.report_fraction(p.fraction_done); }
   bool cancelled() override {
     // A safe place to fail when an allocation had to take the memory reserve.
@@ -50,6 +90,35 @@ class CaseObserver : public RunObserver {
   }
 
  private:
+  // The particles at the mark, as the case with run.gate_length = mark would keep them at its
+  // end: under that case's id, with its result and run records, so that --remeasure measures
+  // them as that case (study/kept_runs.cpp).
+  void keep_gate_mark(double mark_m, const RunSummary& at) {
+    SceneConfig twin = case_.scene;
+    twin.gate_length = mark_m;
+    const nlohmann::json measurement = measure_settings_to_json(ctx_.measurement());
+    char ratio[32], stem[64];
+    std::snprintf(ratio, sizeof ratio, "%g", mark_m / case_.scene.ice_thickness);
+    std::snprintf(stem, sizeof stem, "case_%03zu_gate_%s_", case_.index, ratio);
+    nlohmann::json meta = particle_file_metadata(twin, ctx_.measurement(), case_hash(twin, measurement),
+                                                 case_.label + " (kept at " + ratio + " H_i through the gate)");
+    meta["gate_mark"] = {{"of_case_id", case_.case_id},
+                         {"gate_length_m", mark_m},
+                         {"result", {{"stop_reason", at.stop_reason},
+                                     {"steps", at.steps},
+                                     {"particle_steps", at.particle_steps},
+                                     {"sim_time_s", at.sim_time_s},
+                                     {"extra", result_extra_of(at)}}},
+                         {"run", run_json_of(at, ctx_.earlier_wall_s())}};
+    try {
+      std::filesystem::create_directories(ctx_.particles_dir());
+      write_particle_file(ctx_.particles_dir() / (std::string(stem) + "particles.bin"), at.final_snapshot, meta);
+    } catch (const std::exception& e) {
+      ctx_.warn(std::string("its particles at ") + ratio + " H_i through the gate were not kept (" + e.what() + ")");
+    }
+  }
+
+  const StudyCase& case_;
   CaseContext& ctx_;
   FieldOverTime over_time_;
 };
@@ -159,7 +228,7 @@ CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx) {
   // that ran out of time continues from where it stopped once the limit is raised (the runner
   // keeps the checkpoint).
   scene.wall_time_limit = case_wall_limit_s(scene, ctx);
-  CaseObserver observer(ctx);
+  CaseObserver observer(study_case, ctx);
   RunSummary r;
   try {
     r = run_scene(scene, &observer);
@@ -187,32 +256,14 @@ CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx) {
   out.steps = r.steps;
   out.particle_steps = r.particle_steps;
   out.sim_time_s = r.sim_time_s;
-  out.result_extra = {
-      {"initial_mass_kg", r.initial_mass},    {"final_mass_kg", r.final_mass},
-      {"removed_mass_kg", r.removed_mass},    {"inflow_mass_kg", r.inflow_mass},
-      {"initial_particles", r.initial_particles},
-      {"final_particles", r.final_particles}, {"return_map_evaluations", r.return_map_evaluations}};
+  out.result_extra = result_extra_of(r);
   if (ctx.measure_interval_s() > 0) {
     // The series ends with the final state, measured as the case's result is.
     FieldOverTime series = observer.over_time();
     series.add(r.final_snapshot, ctx.measurement());
     out.result_extra["over_time"] = series.rows();
   }
-  // The whole run's wall time, its earlier sittings included (the checkpoint carries them);
-  // stage_seconds are this sitting's. A format 2 checkpoint did not keep them: then the wall
-  // times stored are this sitting's alone, and run_json says so.
-  const std::optional<double> earlier = ctx.earlier_wall_s();
-  const double engine_wall_s = r.wall_s + earlier.value_or(0.0);
-  out.run_json = {{"engine_wall_s", engine_wall_s},
-                  {"sitting_wall_s", r.wall_s},
-                  {"resumed_from_time_s", r.resumed_from_time_s},
-                  {"stage_seconds", r.stage_seconds},
-                  {"particle_steps_per_s",
-                   engine_wall_s > 0 ? static_cast<double>(r.particle_steps) / engine_wall_s : 0.0}};
-  if (!earlier) {
-    out.run_json["earlier_wall_unknown"] = true;
-    out.run_json["particle_steps_per_s"] = nullptr;  // all the steps over one sitting's wall
-  }
+  out.run_json = run_json_of(r, ctx.earlier_wall_s());
   measure_final_state(study_case, ctx, r.final_snapshot, out);
   return out;
 }

@@ -53,7 +53,7 @@ KeptRuns::KeptRuns(std::filesystem::path db, const std::filesystem::path& partic
         unusable_.push_back({p, "not written by crevasse study --keep-particles"});
       else
         files_.push_back({p, meta.at("case_id").get<std::string>(), meta.at("engine_version").get<std::string>(),
-                          meta.at("measurement"), h.header_checked});
+                          meta.at("measurement"), meta.value("gate_mark", nlohmann::json()), h.header_checked});
     } catch (const std::exception& e) {
       unusable_.push_back({p, e.what()});
     }
@@ -88,13 +88,22 @@ std::vector<std::string> KeptRuns::warnings(const Study& study) const {
     indices.insert(c.index);
     if (const Kept* k = find(c)) used.insert(k->path);
   }
+  // Files of other cases are one line: a longer study's folder holds many (its final particles
+  // and those kept at other gate marks).
+  std::vector<const Kept*> strays;
   for (const Kept& k : files_) {
     if (!used.count(k.path))
-      out.push_back(k.path.string() + ": its particles belong to no case of this study (another scene, or engine " +
-                    k.engine_version + "); ignored");
+      strays.push_back(&k);
     else if (!k.header_checked)
       out.push_back(unchecked_header_warning(k.path));
   }
+  if (strays.size() == 1)
+    out.push_back(strays[0]->path.string() + ": its particles belong to no case of this study (another scene, or engine " +
+                  strays[0]->engine_version + "); ignored");
+  else if (strays.size() > 1)
+    out.push_back(std::to_string(strays.size()) + " kept particle files in " + dir_.string() +
+                  " belong to no case of this study (another scene or engine version), e.g. " +
+                  strays[0]->path.filename().string() + "; ignored");
   for (const Unusable& u : unusable_) {
     const auto index = kept_particles_case_index(u.path);
     if (!index || !indices.count(*index))
@@ -113,7 +122,16 @@ CaseOutcome KeptRuns::operator()(const StudyCase& study_case, CaseContext& ctx) 
                           CREVASSE_ENGINE_VERSION + "; run it without --remeasure (--retry-failed)");
   }
   nlohmann::json result, run;
-  {
+  if (!kept->gate_mark.is_null()) {
+    // Kept by a longer run at this case's stop: its records travel with the particles.
+    try {
+      result = kept->gate_mark.at("result");
+      run = kept->gate_mark.at("run");
+    } catch (const nlohmann::json::exception& e) {
+      throw SimulationError("its kept particles " + kept->path.filename().string() +
+                            " carry unreadable gate-mark records: " + e.what());
+    }
+  } else {
     Store store = Store::open_reader(db_);
     Statement s(store.handle(), "SELECT status, result_json, run_json FROM cases WHERE case_id = ?");
     s.bind(1, kept->case_id);
@@ -141,6 +159,8 @@ CaseOutcome KeptRuns::operator()(const StudyCase& study_case, CaseContext& ctx) 
   out.run_json.erase("peak_rss_exact");  // the runner's, for this process
   out.run_json["measured_from"] = {
       {"database", db_.string()}, {"case_id", kept->case_id}, {"particles", kept->path.string()}};
+  if (!kept->gate_mark.is_null())
+    out.run_json["measured_from"]["kept_at_gate_mark_of_case_id"] = kept->gate_mark.value("of_case_id", "");
   measure_final_state(study_case, ctx, file.snapshot, out);
   return out;
 }

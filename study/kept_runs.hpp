@@ -42,6 +42,7 @@ class KeptRuns {
     std::string case_id;
     std::string engine_version;
     nlohmann::json measurement;
+    nlohmann::json gate_mark;  // null, or the records of a run kept at a gate mark (study/engine_case.cpp)
     bool header_checked = true;
   };
   struct Unusable {

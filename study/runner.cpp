@@ -294,6 +294,7 @@ class StudyRun {
     if (!opt_.views_dir.empty()) ctx.set_views_dir(opt_.views_dir);
     if (!opt_.particles_dir.empty()) ctx.set_particles_dir(opt_.particles_dir);
     ctx.set_measure_interval(study_.measure_interval_s);
+    ctx.set_gate_mark_ratios(study_.gate_mark_ratios);
     ctx.set_warn([this, slot](const std::string& m) { queue_.push(Event{Event::Kind::warning, slot, {}, {}, m}); });
     std::filesystem::path checkpoint;
     if (study_.resources.checkpoint_interval_s > 0) {

@@ -438,6 +438,17 @@ void parse_protocol(const ordered_json& doc, json& measurement, Study& st) {
   if (doc.contains("measure_interval_s"))
     st.measure_interval_s =
         number_in(doc.at("measure_interval_s"), "measure_interval_s", {0.0, 1e6, false, false});
+  // One run serving a shorter protocol too: its particles kept when this much ice (in H_i) has
+  // passed the gate, as the case stopped there would keep them (docs/study_format.md).
+  const std::string marks = "keep_particles_at_gate_length_ratios";
+  if (doc.contains(marks)) {
+    const ordered_json& a = doc.at(marks);
+    if (!a.is_array() || a.empty() || a.size() > 100 ||
+        std::any_of(a.begin(), a.end(), [](const ordered_json& x) { return !x.is_number(); }))
+      fail(marks, "must be a list of 1 to 100 lengths of ice through the gate in H_i, each in (0, 1000], got " + a.dump());
+    for (std::size_t i = 0; i < a.size(); ++i)
+      st.gate_mark_ratios.push_back(number_in(a[i], marks + "[" + std::to_string(i) + "]", {0.0, 1e3, true, false}));
+  }
   if (!doc.contains("protocol")) return;
   const ordered_json& p = doc.at("protocol");
   static const std::map<std::string, std::string> frame_of = {{"initiation", "draped"},
@@ -587,7 +598,7 @@ Study parse_study(const std::string& text, const std::filesystem::path& base_dir
   if (!doc.is_object()) fail(source, "a study file must be a JSON object");
   refuse_unknown_keys(doc, "",
                  {"name", "description", "base_scene", "fixed", "sweep", "replicas", "measurement",
-                  "resources", "protocol", "measure_interval_s"});
+                  "resources", "protocol", "measure_interval_s", "keep_particles_at_gate_length_ratios"});
   parse_name_and_base(doc, base_dir, st);
   parse_parameters(doc, st);
   json measurement = doc.contains("measurement") ? json(doc.at("measurement")) : json();

@@ -94,6 +94,11 @@ struct Study {
   // series in result_json.extra.over_time, to see when the field settles. Not part of a
   // case's identity: the measurement at the end is the same with or without it.
   double measure_interval_s = 0.0;
+  // "keep_particles_at_gate_length_ratios": where a case keeps its particles (--keep-particles)
+  // it also keeps them when this much ice, in H_i, has passed the gate, under the id of the case
+  // that stops there (run.gate_length = ratio × H_i), for --remeasure. Not part of a case's
+  // identity.
+  std::vector<double> gate_mark_ratios;
   std::vector<StudyCase> cases;
   std::string study_hash;  // SHA-256 of the sorted case ids: same cases ⇔ same study
 };

@@ -583,5 +583,64 @@ TEST(Cli, RemeasureFromKeptParticlesStoresWhatAFullRunStores) {
   EXPECT_FALSE(std::filesystem::exists(dir / "x.db")) << "refused, yet the study began";
 }
 
+// One run serves a shorter protocol: a study whose cases keep their particles when 0.35 H_i has
+// passed the gate (keep_particles_at_gate_length_ratios, a ratio with no exact binary form) lets
+// --remeasure fill the study that stops there, storing exactly what running that study stores.
+TEST(Cli, ParticlesKeptAtAGateMarkServeTheStudyThatStopsThere) {
+  test::ScratchDir dir("cli");
+  nlohmann::json shorter = test::tiny_study(2, 100000, "shorter");
+  shorter["fixed"]["gate_length_ratio"] = 0.35;
+  shorter["protocol"] = "initiation";
+  test::write_text(dir / "shorter.json", shorter.dump(2));
+  nlohmann::json longer = shorter;
+  longer["name"] = "longer";
+  longer["fixed"]["gate_length_ratio"] = 0.7;
+  longer["protocol"] = "steady";
+  longer["keep_particles_at_gate_length_ratios"] = {0.35};
+  test::write_text(dir / "longer.json", longer.dump(2));
+  ASSERT_EQ(run_cli(dir.path(), "study shorter.json --db full.db --quiet").code, 0);
+  ASSERT_EQ(run_cli(dir.path(), "study longer.json --db longer.db --keep-particles --quiet").code, 0);
+  EXPECT_TRUE(std::filesystem::exists(dir / "longer.db.particles" / "case_001_gate_0.35_particles.bin"));
+  const Result again = run_cli(dir.path(), "study shorter.json --db again.db --remeasure longer.db --particles-from "
+                                           "longer.db.particles --quiet");
+  ASSERT_EQ(again.code, 0) << again.err;
+  // The longer study's own final particles are named in one line, not one per file.
+  EXPECT_NE(again.err.find("2 kept particle files"), std::string::npos) << again.err;
+  auto results = [&](const char* db) {
+    std::vector<std::string> all;
+    for (const char* sql : {"SELECT case_id, case_index, status, stop_reason, steps, particle_steps, sim_time_s, "
+                            "result_json, result_hash FROM cases ORDER BY case_id",
+                            "SELECT * FROM crevasses ORDER BY case_id, crevasse_index",
+                            "SELECT * FROM summaries ORDER BY case_id"}) {
+      const auto rows = test::dump_rows(dir / db, sql);
+      all.insert(all.end(), rows.begin(), rows.end());
+    }
+    return all;
+  };
+  EXPECT_EQ(results("again.db"), results("full.db"));
+  const auto steps = [&](const char* db) { return test::dump_rows(dir / db, "SELECT steps FROM cases ORDER BY case_index"); };
+  EXPECT_NE(steps("longer.db"), steps("full.db")) << "the longer study stopped where the shorter does: the test shows nothing";
+  // Each says which run kept its particles.
+  EXPECT_EQ(test::dump_rows(dir / "again.db", "SELECT json_extract(run_json, '$.measured_from.kept_at_gate_mark_of_case_id') "
+                                              "FROM cases ORDER BY case_index"),
+            test::dump_rows(dir / "longer.db", "SELECT case_id FROM cases ORDER BY case_index"));
+}
+
+// The gate marks' field is checked like every other: a list of lengths in (0, 1000].
+TEST(Cli, GateMarksOutsideTheirRangeAreRefused) {
+  test::ScratchDir dir("cli");
+  for (const char* bad : {"[]", "[0]", "[1.5, -1]", "[\"a\"]", "0.5"}) {
+    nlohmann::json st = test::tiny_study(2, 100, "marks");
+    st["keep_particles_at_gate_length_ratios"] = nlohmann::json::parse(bad);
+    test::write_text(dir / "marks.json", st.dump(2));
+    const Result r = run_cli(dir.path(), "study marks.json --db marks.db --quiet");
+    EXPECT_EQ(r.code, 2) << bad << ": " << r.err;
+    EXPECT_NE(r.err.find("keep_particles_at_gate_length_ratios"), std::string::npos) << bad << ": " << r.err;
+    EXPECT_NE(r.err.find("(0, 1000]"), std::string::npos) << bad << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << bad << ": " << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "marks.db")) << bad;
+  }
+}
+
 }  // namespace
 }  // namespace crevasse

@@ -427,5 +427,93 @@ TEST(Checkpoint, ARunOutOfTimeSavesItsCheckpointAndContinuesUnderALargerLimit) {
   expect_same_state(whole.final_snapshot, second.final_snapshot);
 }
 
+// An observer of gate marks (RunObserver::gate_marks): it records each call, and can cancel the
+// run at a simulated time or at a mark, leaving a checkpoint on either side of it.
+class MarkObserver : public CheckpointingObserver {
+ public:
+  MarkObserver(fs::path file, std::vector<double> marks)
+      : CheckpointingObserver(std::move(file), 0), marks_(std::move(marks)) {}
+  std::vector<double> gate_marks() const override { return marks_; }
+  void on_gate_mark(double mark_m, const RunSummary& at) override {
+    calls.emplace_back(mark_m, at);
+    if (cancel_at_mark) cancel_now = true;
+  }
+  double snapshot_interval_s() const override { return cancel_at_time_s > 0 ? 0.5 : 0.0; }
+  void on_snapshot(const ParticleSnapshot& s) override {
+    if (s.time_s >= cancel_at_time_s) cancel_now = true;
+  }
+  std::vector<std::pair<double, RunSummary>> calls;
+  bool cancel_at_mark = false;
+  double cancel_at_time_s = 0.0;
+
+ private:
+  std::vector<double> marks_;
+};
+
+nlohmann::json gate_scene(double gate_length_m) {
+  nlohmann::json j = test::shipped_scene_json();
+  j["run"]["gate_length"] = gate_length_m;
+  return j;
+}
+
+// One run serves a shorter protocol: at each mark the observer gets, bit for bit, what a run with
+// run.gate_length = that mark ends with, and the run goes on to its own stop.
+TEST(GateMark, IsWhatARunStoppedThereEndsWith) {
+  const RunSummary shorter = run_scene(scene_from_json(gate_scene(30.0)));
+  ASSERT_EQ(shorter.stop_reason, "gate_length");
+  MarkObserver obs("", {30.0, 15.0});  // in any order
+  const RunSummary longer = run_scene(scene_from_json(gate_scene(45.0)), &obs);
+  ASSERT_EQ(longer.stop_reason, "gate_length");
+  ASSERT_EQ(obs.calls.size(), 2u);
+  EXPECT_EQ(obs.calls[0].first, 15.0);
+  EXPECT_EQ(obs.calls[1].first, 30.0);
+  const RunSummary& at = obs.calls[1].second;
+  EXPECT_EQ(at.stop_reason, "gate_length");
+  EXPECT_EQ(at.steps, shorter.steps);
+  EXPECT_EQ(at.particle_steps, shorter.particle_steps);
+  EXPECT_EQ(at.return_map_evaluations, shorter.return_map_evaluations);
+  EXPECT_EQ(at.sim_time_s, shorter.sim_time_s);
+  EXPECT_EQ(at.initial_mass, shorter.initial_mass);
+  EXPECT_EQ(at.final_mass, shorter.final_mass);
+  EXPECT_EQ(at.removed_mass, shorter.removed_mass);
+  EXPECT_EQ(at.final_particles, shorter.final_particles);
+  EXPECT_EQ(at.final_ice_front_x, shorter.final_ice_front_x);
+  expect_same_state(shorter.final_snapshot, at.final_snapshot);
+  EXPECT_GT(longer.steps, at.steps) << "the run stopped at the mark: the test shows nothing";
+  EXPECT_GT(obs.calls[1].second.steps, obs.calls[0].second.steps);
+}
+
+// A resumed run calls a mark it had not reached before its checkpoint once, with the state the
+// uninterrupted run had there, and one it had reached (and called) not again.
+TEST(GateMark, AResumedRunCallsEachMarkOnce) {
+  const SceneConfig scene = scene_from_json(gate_scene(50.0));
+  MarkObserver whole("", {35.0});
+  ASSERT_EQ(run_scene(scene, &whole).stop_reason, "gate_length");
+  ASSERT_EQ(whole.calls.size(), 1u);
+  const RunSummary& ref = whole.calls[0].second;
+
+  const fs::path before = scratch("mark_before");
+  MarkObserver a(before, {35.0});
+  a.cancel_at_time_s = 1.0;
+  ASSERT_EQ(run_scene(scene, &a).stop_reason, "cancelled");
+  ASSERT_TRUE(a.calls.empty()) << "cancelled only after the mark: the test shows nothing";
+  MarkObserver b(before, {35.0});
+  ASSERT_EQ(run_scene(scene, &b).stop_reason, "gate_length");
+  ASSERT_EQ(b.calls.size(), 1u);
+  EXPECT_EQ(b.calls[0].second.steps, ref.steps);
+  expect_same_state(ref.final_snapshot, b.calls[0].second.final_snapshot);
+
+  const fs::path after = scratch("mark_after");
+  MarkObserver c(after, {35.0});
+  c.cancel_at_mark = true;
+  const RunSummary cut = run_scene(scene, &c);
+  ASSERT_EQ(cut.stop_reason, "cancelled") << "the run ended before it could be interrupted";
+  ASSERT_EQ(c.calls.size(), 1u);
+  EXPECT_GT(cut.steps, c.calls[0].second.steps);
+  MarkObserver d(after, {35.0});
+  ASSERT_EQ(run_scene(scene, &d).stop_reason, "gate_length");
+  EXPECT_TRUE(d.calls.empty()) << "called again after the resume";
+}
+
 }  // namespace
 }  // namespace crevasse
