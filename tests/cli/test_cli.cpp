@@ -500,6 +500,19 @@ TEST(Cli, StudyKeepsParticlesThatMeasureAsStored) {
   EXPECT_GT(damaged, 0) << "nothing was damaged: the comparison shows little; run the cases longer";
 }
 
+// What a study stores of its cases' results: records, result hashes, crevasses and summaries.
+std::vector<std::string> stored_results(const std::filesystem::path& db) {
+  std::vector<std::string> all;
+  for (const char* sql : {"SELECT case_id, case_index, status, stop_reason, steps, particle_steps, sim_time_s, "
+                          "result_json, result_hash FROM cases ORDER BY case_id",
+                          "SELECT * FROM crevasses ORDER BY case_id, crevasse_index",
+                          "SELECT * FROM summaries ORDER BY case_id"}) {
+    const auto rows = test::dump_rows(db, sql);
+    all.insert(all.end(), rows.begin(), rows.end());
+  }
+  return all;
+}
+
 // A study that differs from a finished one only in its measurement can be measured from the
 // particles that study kept (`--remeasure DB --particles-from DIR`) instead of simulating it
 // again, and it stores exactly what a full run stores: the same case ids, records, result
@@ -521,17 +534,7 @@ TEST(Cli, RemeasureFromKeptParticlesStoresWhatAFullRunStores) {
   const Result again = run_cli(dir.path(), "study other.json --db again.db --remeasure kept.db --particles-from v --views w --quiet");
   ASSERT_EQ(again.code, 0) << again.err;
   ASSERT_EQ(run_cli(dir.path(), "study other.json --db full.db --quiet").code, 0);
-  auto results = [&](const char* db) {
-    std::vector<std::string> all;
-    for (const char* sql : {"SELECT case_id, case_index, status, stop_reason, steps, particle_steps, sim_time_s, "
-                            "result_json, result_hash FROM cases ORDER BY case_id",
-                            "SELECT * FROM crevasses ORDER BY case_id, crevasse_index",
-                            "SELECT * FROM summaries ORDER BY case_id"}) {
-      const auto rows = test::dump_rows(dir / db, sql);
-      all.insert(all.end(), rows.begin(), rows.end());
-    }
-    return all;
-  };
+  const auto results = [&](const char* db) { return stored_results(dir / db); };
   EXPECT_EQ(results("again.db"), results("full.db"));
   EXPECT_NE(results("kept.db"), results("full.db")) << "the settings changed nothing: the test shows nothing";
   EXPECT_EQ(test::dump_rows(dir / "again.db", "SELECT count(*) FROM cases WHERE json_extract(run_json, "
@@ -606,17 +609,7 @@ TEST(Cli, ParticlesKeptAtAGateMarkServeTheStudyThatStopsThere) {
   ASSERT_EQ(again.code, 0) << again.err;
   // The longer study's own final particles are named in one line, not one per file.
   EXPECT_NE(again.err.find("2 kept particle files"), std::string::npos) << again.err;
-  auto results = [&](const char* db) {
-    std::vector<std::string> all;
-    for (const char* sql : {"SELECT case_id, case_index, status, stop_reason, steps, particle_steps, sim_time_s, "
-                            "result_json, result_hash FROM cases ORDER BY case_id",
-                            "SELECT * FROM crevasses ORDER BY case_id, crevasse_index",
-                            "SELECT * FROM summaries ORDER BY case_id"}) {
-      const auto rows = test::dump_rows(dir / db, sql);
-      all.insert(all.end(), rows.begin(), rows.end());
-    }
-    return all;
-  };
+  const auto results = [&](const char* db) { return stored_results(dir / db); };
   EXPECT_EQ(results("again.db"), results("full.db"));
   const auto steps = [&](const char* db) { return test::dump_rows(dir / db, "SELECT steps FROM cases ORDER BY case_index"); };
   EXPECT_NE(steps("longer.db"), steps("full.db")) << "the longer study stopped where the shorter does: the test shows nothing";
