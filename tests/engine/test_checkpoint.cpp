@@ -509,7 +509,7 @@ TEST(GateMark, AResumedRunCallsEachMarkOnce) {
   const RunSummary cut = run_scene(scene, &c);
   ASSERT_EQ(cut.stop_reason, "cancelled") << "the run ended before it could be interrupted";
   ASSERT_EQ(c.calls.size(), 1u);
-  EXPECT_GT(cut.steps, c.calls[0].second.steps);
+  EXPECT_GE(cut.steps, c.calls[0].second.steps);  // its checkpoint at the mark's step or later
   MarkObserver d(after, {35.0});
   ASSERT_EQ(run_scene(scene, &d).stop_reason, "gate_length");
   EXPECT_TRUE(d.calls.empty()) << "called again after the resume";
