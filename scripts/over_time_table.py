@@ -52,6 +52,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("db", help="study database, or a running case's CASE.ckpt.over_time.json")
     ap.add_argument("--thickness", type=float, default=0.0, help="H_i [m], with an over_time.json file")
+    ap.add_argument("--pi", type=float, default=float("nan"), help="Pi, with an over_time.json file (shown only)")
     ap.add_argument("--cases", default="", help="case indices, comma-separated (default all)")
     ap.add_argument("--every", type=float, default=0.0, help="print one row per this many H_i pushed")
     ap.add_argument("--tolerance-cracks", type=int, default=1)
@@ -62,7 +63,7 @@ def main():
         if a.thickness <= 0:
             sys.exit("over_time_table: give --thickness (H_i in m) with an over_time.json file")
         try:
-            rows = [(0, a.thickness, float("nan"), 0, json.dumps({"extra": {"over_time": json.load(open(a.db))}}))]
+            rows = [(0, a.thickness, a.pi, 0, json.dumps({"extra": {"over_time": json.load(open(a.db))}}))]
         except (OSError, ValueError) as e:
             sys.exit(f"over_time_table: cannot read {a.db}: {e}")
     else:
@@ -91,7 +92,7 @@ def show(rows, a):
             print(f"case {idx}: no over_time (run with measure_interval_s)")
             continue
         k = settled_from(ot, h, a.tolerance_cracks, tol_len)
-        print(f"case {idx}: H_i = {h:g} m, Pi = {pi:g}, seed {seed}; {len(ot)} samples; "
+        print(f"case {idx}: H_i = {h:g} m, Pi = {pi:g}{f', seed {seed}' if seed else ''}; {len(ot)} samples; "
               f"settled (count within {a.tolerance_cracks}, spacing and depth within {tol_len:g} H_i of the end) "
               f"from {ot[k]['pushed_over_h']:.2f} H_i pushed, t = {ot[k]['time_s']:.0f} s")
         print(f"{'t/s':>6} {'pushed/H':>8} {'n':>3} {'q25/m':>7} {'med/m':>7} {'q75/m':>7} {'med/H':>6} "
