@@ -586,24 +586,26 @@ TEST(Cli, RemeasureFromKeptParticlesStoresWhatAFullRunStores) {
   EXPECT_FALSE(std::filesystem::exists(dir / "x.db")) << "refused, yet the study began";
 }
 
-// One run serves a shorter protocol: a study whose cases keep their particles when 0.35 H_i has
+// One run serves a shorter protocol: a study whose cases keep their particles when 1.05 H_i has
 // passed the gate (keep_particles_at_gate_length_ratios, a ratio with no exact binary form) lets
-// --remeasure fill the study that stops there, storing exactly what running that study stores.
+// --remeasure fill the study that stops there, storing exactly what running that study stores,
+// damaged ice and all.
 TEST(Cli, ParticlesKeptAtAGateMarkServeTheStudyThatStopsThere) {
   test::ScratchDir dir("cli");
   nlohmann::json shorter = test::tiny_study(2, 100000, "shorter");
-  shorter["fixed"]["gate_length_ratio"] = 0.35;
+  shorter["sweep"] = {{"cohesion_ratio", {0.05, 0.1}}};
+  shorter["fixed"]["gate_length_ratio"] = 1.05;
   shorter["protocol"] = "initiation";
   test::write_text(dir / "shorter.json", shorter.dump(2));
   nlohmann::json longer = shorter;
   longer["name"] = "longer";
-  longer["fixed"]["gate_length_ratio"] = 0.7;
+  longer["fixed"]["gate_length_ratio"] = 2.1;
   longer["protocol"] = "steady";
-  longer["keep_particles_at_gate_length_ratios"] = {0.35};
+  longer["keep_particles_at_gate_length_ratios"] = {1.05};
   test::write_text(dir / "longer.json", longer.dump(2));
   ASSERT_EQ(run_cli(dir.path(), "study shorter.json --db full.db --quiet").code, 0);
   ASSERT_EQ(run_cli(dir.path(), "study longer.json --db longer.db --keep-particles --quiet").code, 0);
-  EXPECT_TRUE(std::filesystem::exists(dir / "longer.db.particles" / "case_001_gate_0.35_particles.bin"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "longer.db.particles" / "case_001_gate_1.05_particles.bin"));
   const Result again = run_cli(dir.path(), "study shorter.json --db again.db --remeasure longer.db --particles-from "
                                            "longer.db.particles --quiet");
   ASSERT_EQ(again.code, 0) << again.err;
@@ -611,6 +613,9 @@ TEST(Cli, ParticlesKeptAtAGateMarkServeTheStudyThatStopsThere) {
   EXPECT_NE(again.err.find("2 kept particle files"), std::string::npos) << again.err;
   const auto results = [&](const char* db) { return stored_results(dir / db); };
   EXPECT_EQ(results("again.db"), results("full.db"));
+  for (const std::string& n : test::dump_rows(dir / "full.db", "SELECT json_extract(result_json, "
+                                                                "'$.measurement.counts.damaged_particles') FROM cases"))
+    EXPECT_GT(std::stoll(n), 0) << "no damaged ice: the measurement compared shows little";
   const auto steps = [&](const char* db) { return test::dump_rows(dir / db, "SELECT steps FROM cases ORDER BY case_index"); };
   EXPECT_NE(steps("longer.db"), steps("full.db")) << "the longer study stopped where the shorter does: the test shows nothing";
   // Each says which run kept its particles.
