@@ -221,11 +221,13 @@ bool uses_gate_frame(const ParticleSnapshot& snapshot, const MeasureSettings& se
 // there cannot show strength-spaced crevasses, so it is flagged and left out of fits by default
 // (docs/measurement.md, "Resolution rule").
 inline constexpr double kStrengthLengthMinCells = 3.0;
+// A study that puts c/(ρ_i g) on the floor itself (Π = 3 dx/H_i) derives c through Π ρ_i g H_i,
+// whose round-off must not push it under: the floor holds to this relative tolerance.
+inline constexpr double kStrengthFloorTolerance = 1e-9;
 inline bool strength_under_resolved(double tensile_strength_pa, double density, double gravity,
                                     double dx_m) {
-  // A study that puts c/(ρ_i g) on the floor itself (Π = 3 dx/H_i) derives c through Π ρ_i g H_i,
-  // whose round-off must not push it under: the floor holds to a relative 1e-9.
-  return strength_length(tensile_strength_pa, density, gravity) < kStrengthLengthMinCells * dx_m * (1.0 - 1e-9);
+  return strength_length(tensile_strength_pa, density, gravity) <
+         kStrengthLengthMinCells * dx_m * (1.0 - kStrengthFloorTolerance);
 }
 
 }  // namespace crevasse::analysis

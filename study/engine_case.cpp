@@ -45,6 +45,27 @@ nlohmann::json run_json_of(const RunSummary& r, std::optional<double> earlier) {
   return run;
 }
 
+
+// A side file of the case (its views, its kept particles) is a view of the result, not the
+// result: one that cannot be written (a full disk) is reported, and the case is stored all the same.
+template <class Write>
+void write_side_files(CaseContext& ctx, const std::filesystem::path& dir, const std::string& what, const Write& write) {
+  if (dir.empty()) return;
+  try {
+    std::filesystem::create_directories(dir);
+    write(dir);
+  } catch (const std::exception& e) {
+    ctx.warn("its " + what + " in " + dir.string() + " were not all written (" + e.what() + "); its result is stored");
+  }
+}
+
+// case_NNN_ (NNN as --dry-run lists the cases), the stem of every file a case writes.
+std::string case_file_stem(std::size_t index) {
+  char stem[32];
+  std::snprintf(stem, sizeof stem, "case_%03zu_", index);
+  return stem;
+}
+
 class CaseObserver : public RunObserver {
  public:
   CaseObserver(const StudyCase& study_case, CaseContext& ctx)
@@ -97,9 +118,8 @@ class CaseObserver : public RunObserver {
     SceneConfig twin = case_.scene;
     twin.gate_length = mark_m;
     const nlohmann::json measurement = measure_settings_to_json(ctx_.measurement());
-    char ratio[32], stem[64];
+    char ratio[32];
     std::snprintf(ratio, sizeof ratio, "%g", mark_m / case_.scene.ice_thickness);
-    std::snprintf(stem, sizeof stem, "case_%03zu_gate_%s_", case_.index, ratio);
     nlohmann::json meta = particle_file_metadata(twin, ctx_.measurement(), case_hash(twin, measurement),
                                                  case_.label + " (kept at " + ratio + " H_i through the gate)");
     meta["gate_mark"] = {{"of_case_id", case_.case_id},
@@ -110,12 +130,9 @@ class CaseObserver : public RunObserver {
                                      {"sim_time_s", at.sim_time_s},
                                      {"extra", result_extra_of(at)}}},
                          {"run", run_json_of(at, ctx_.earlier_wall_s())}};
-    try {
-      std::filesystem::create_directories(ctx_.particles_dir());
-      write_particle_file(ctx_.particles_dir() / (std::string(stem) + "particles.bin"), at.final_snapshot, meta);
-    } catch (const std::exception& e) {
-      ctx_.warn(std::string("its particles at ") + ratio + " H_i through the gate were not kept (" + e.what() + ")");
-    }
+    const std::string name = case_file_stem(case_.index) + "gate_" + ratio + "_particles.bin";
+    write_side_files(ctx_, ctx_.particles_dir(), std::string("particles at ") + ratio + " H_i through the gate",
+                     [&](const std::filesystem::path& dir) { write_particle_file(dir / name, at.final_snapshot, meta); });
   }
 
   const StudyCase& case_;
@@ -196,25 +213,12 @@ void measure_final_state(const StudyCase& study_case, CaseContext& ctx, const Pa
     out.measurement.reset();
     return;
   }
-  char stem[32];
-  std::snprintf(stem, sizeof stem, "case_%03zu_", study_case.index);
-  // The side files are a view of the result, not the result: one that cannot be written (a
-  // full disk) is reported, and the case's measurement is stored all the same.
-  const auto side_files = [&](const std::filesystem::path& dir, const auto& write) {
-    if (dir.empty()) return;
-    try {
-      std::filesystem::create_directories(dir);
-      write(dir);
-    } catch (const std::exception& e) {
-      ctx.warn(std::string("its side files in ") + dir.string() + " were not all written (" + e.what() +
-               "); its result is stored");
-    }
-  };
-  side_files(ctx.views_dir(), [&](const std::filesystem::path& dir) {
+  const std::string stem = case_file_stem(study_case.index);
+  write_side_files(ctx, ctx.views_dir(), "side views", [&](const std::filesystem::path& dir) {
     write_case_views(study_case.scene, final_snapshot, *out.measurement, dir, stem);
   });
-  side_files(ctx.particles_dir(), [&](const std::filesystem::path& dir) {
-    write_particle_file(dir / (std::string(stem) + "particles.bin"), final_snapshot,
+  write_side_files(ctx, ctx.particles_dir(), "kept particles", [&](const std::filesystem::path& dir) {
+    write_particle_file(dir / (stem + "particles.bin"), final_snapshot,
                         particle_file_metadata(study_case.scene, ctx.measurement(), study_case.case_id, study_case.label));
   });
 }

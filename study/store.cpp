@@ -261,9 +261,11 @@ namespace {
 
 // analysis::strength_under_resolved over a cases row, for files written before the column.
 std::string under_resolved_rule_sql() {
+  char floor[64];
+  std::snprintf(floor, sizeof floor, "%.17g",
+                analysis::kStrengthLengthMinCells * (1.0 - analysis::kStrengthFloorTolerance));
   return "(tensile_strength_pa / (json_extract(scene_json, '$.ice.density') * "
-         "json_extract(scene_json, '$.gravity.g')) < " +
-         std::to_string(analysis::kStrengthLengthMinCells) + " * dx_m)";
+         "json_extract(scene_json, '$.gravity.g')) < " + std::string(floor) + " * dx_m)";
 }
 
 int read_user_version(sqlite3* db) {
@@ -378,6 +380,12 @@ Store Store::open_writer(const fs::path& path, double wait_s, const std::string&
       store.exec(kSchema);
       store.exec("PRAGMA user_version = " + std::to_string(kStoreSchemaVersion));
     });
+    // The flag is derived from the row: a file written under an older rule is brought up to
+    // the current one, so fits and diagrams never leave out a case the rule keeps.
+    if (version >= 2) {
+      const std::string rule = under_resolved_rule_sql();
+      store.exec("UPDATE cases SET under_resolved = " + rule + " WHERE under_resolved != " + rule);
+    }
   } catch (const std::runtime_error& e) {
     const bool resource = dynamic_cast<const ResourceError*>(&e) != nullptr;
     const std::string message = dynamic_cast<const InputError*>(&e) || resource

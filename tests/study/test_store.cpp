@@ -71,6 +71,49 @@ TEST(Store, RefusesOtherFilesAndOtherStudies) {
   }
 }
 
+// A case with c/(ρ_i g) on the resolution floor itself (Π = 3 dx/H_i; round-off puts the length a
+// hair under 30 m) is resolved, whether the flag comes from the row's column, from the rule a
+// version-1 file is read with, or from a column an older rule wrote.
+TEST(Store, TheResolutionFloorHoldsInEveryWayTheFlagIsRead) {
+  test::ScratchDir dir("store");
+  auto j = test::tiny_study(1);
+  j["fixed"]["thickness"] = 200.0;
+  j["sweep"] = {{"cohesion_ratio", {0.1, 0.15, 0.2}}};  // below, on and above 30 m at dx = 10 m
+  const Study study = test::parse(j);
+  const auto db = dir / "s.db";
+  const std::string flags = "SELECT group_concat(f, ',') FROM (SELECT under_resolved AS f FROM cases ORDER BY case_index)";
+  {
+    Store store = Store::open_writer(db);
+    store.init_study(study);
+    store.add_cases(all_cases(study));
+  }
+  EXPECT_EQ(test::dump_rows(db, flags).at(0), "1,0,0");
+
+  // A column an older rule wrote is brought up to the current rule when a writer opens the file.
+  { Store store = Store::open_writer(db); store.exec("UPDATE cases SET under_resolved = 1"); }
+  { Store store = Store::open_writer(db); }
+  EXPECT_EQ(test::dump_rows(db, flags).at(0), "1,0,0");
+
+  // A version-1 file (no column): read with the rule, then upgraded by a writer.
+  {
+    Store store = Store::open_writer(db);
+    store.exec("DROP INDEX IF EXISTS cases_by_status");
+    store.exec("ALTER TABLE cases DROP COLUMN under_resolved");
+    store.exec("PRAGMA user_version = 1");
+  }
+  {
+    Store reader = Store::open_reader(db);
+    ASSERT_EQ(reader.schema_version(), 1);
+    Statement s(reader.handle(),
+                "SELECT " + reader.under_resolved_column() + " FROM cases ORDER BY case_index");
+    std::string got;
+    while (s.step()) got += (got.empty() ? "" : ",") + std::to_string(s.integer(0));
+    EXPECT_EQ(got, "1,0,0");
+  }
+  { Store store = Store::open_writer(db); }
+  EXPECT_EQ(test::dump_rows(db, flags).at(0), "1,0,0");
+}
+
 TEST(Store, AFinishedCaseIsStoredWhole) {
   test::ScratchDir dir("store");
   const Study study = test::parse(test::tiny_study(3));
