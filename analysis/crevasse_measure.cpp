@@ -358,9 +358,10 @@ CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
         static_cast<double>(broken) > r.fragmented_fraction * static_cast<double>(occupied);
   }
 
+  const std::size_t particle_total = px.size();  // gap points, if any, come after the particles
   if (r.count_gaps) {  // after the counts above, which are of particles only
     const GapPoints gaps =
-        find_opened_gaps(px, pz, m.surface, snapshot.bed_profile, r.dx_m, r.particle_spacing_m);
+        find_opened_gaps(px, pz, damaged, m.surface, snapshot.bed_profile, r.dx_m, r.particle_spacing_m);
     px.insert(px.end(), gaps.x.begin(), gaps.x.end());
     pz.insert(pz.end(), gaps.z.begin(), gaps.z.end());
     damaged.insert(damaged.end(), gaps.x.size(), 1);
@@ -403,9 +404,19 @@ CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
     if (!damaged[t]) intact_top[bin_of(px[t])] = 1;
     else top_x[static_cast<std::size_t>(clusters.label[t])].push_back(px[t]);
   }
-  for (std::size_t p = 0; p < px.size(); ++p) {
+  // Where a crevasse is: its damaged particles at the surface. Gap points join the walls of an
+  // opened crack and carry its depth, but place it only where no damaged particle reaches the
+  // surface (the notch a parted crack leaves beside it would pull the position off the crack).
+  for (std::size_t p = 0; p < particle_total; ++p) {
     const auto c = clusters.label[p];
     if (c != DamageClusters::kNone && reaches_surface(p)) surface_x[static_cast<std::size_t>(c)].push_back(px[p]);
+  }
+  std::vector<std::uint8_t> placed_by_particles(clusters.count, 0);
+  for (std::size_t c = 0; c < clusters.count; ++c) placed_by_particles[c] = !surface_x[c].empty();
+  for (std::size_t p = particle_total; p < px.size(); ++p) {
+    const auto c = clusters.label[p];
+    if (c != DamageClusters::kNone && !placed_by_particles[static_cast<std::size_t>(c)] && reaches_surface(p))
+      surface_x[static_cast<std::size_t>(c)].push_back(px[p]);
   }
   auto intact_between = [&](double a, double b) {
     for (std::size_t k = bin_of(a) + 1; k < bin_of(b); ++k)

@@ -70,6 +70,40 @@ TEST(OpenedGaps, ACrackOfEmptySpaceIsMeasuredToItsBottom) {
   EXPECT_EQ(with.window_damaged_count, without.window_damaged_count);
 }
 
+// A dip in the surface that the bridged profile spans, between walls of intact ice, is not a
+// crack: counting gaps reads no crevasse there, while the same dip with a damaged wall is one.
+TEST(OpenedGaps, ADipBetweenIntactWallsIsNotACrack) {
+  test::SlabSpec spec;
+  spec.thickness_m = 200.0;  // bridged over up to 2 x 50 m
+  ParticleSnapshot intact = test::make_slab(spec, {});
+  open_gap(intact, 985.0, 1035.0, 160.0, 200.0);  // 50 m wide, 40 m deep
+  const CrevasseMeasurement dip = measure_crevasses(intact, final_frame(true));
+  EXPECT_TRUE(dip.crevasses.empty()) << dip.crevasses.size() << " crevasse(s), the first "
+                                     << (dip.crevasses.empty() ? 0.0 : dip.crevasses[0].depth_m) << " m deep";
+
+  ParticleSnapshot cracked = test::make_slab(spec, {{1037.5, 20.0, 0.0}});  // its right wall damaged
+  open_gap(cracked, 985.0, 1035.0, 160.0, 200.0);
+  const CrevasseMeasurement crack = measure_crevasses(cracked, final_frame(true));
+  ASSERT_EQ(crack.crevasses.size(), 1u);
+  EXPECT_NEAR(crack.crevasses[0].depth_m, 40.0, 10.0);
+}
+
+// A parted crack leaves a notch beside it at the surface. The notch's gap joins the crack and
+// may carry its depth, but the crack is where its damaged particles meet the surface.
+TEST(OpenedGaps, ANotchBesideACrackDoesNotMoveIt) {
+  test::SlabSpec spec;
+  spec.thickness_m = 200.0;
+  ParticleSnapshot s = test::make_slab(spec, {{1002.5, 100.0, 0.0}});
+  open_gap(s, 945.0, 1000.0, 175.0, 200.0);  // a notch 55 m wide, 25 m deep, against the crack
+  const CrevasseMeasurement without = measure_crevasses(s, final_frame(false));
+  const CrevasseMeasurement with = measure_crevasses(s, final_frame(true));
+  ASSERT_EQ(without.crevasses.size(), 1u);
+  ASSERT_EQ(with.crevasses.size(), 1u);
+  EXPECT_NEAR(without.crevasses[0].x_m, 1002.5, 1.0);
+  EXPECT_EQ(with.crevasses[0].x_m, without.crevasses[0].x_m);
+  EXPECT_NEAR(with.crevasses[0].depth_m, without.crevasses[0].depth_m, 5.0);
+}
+
 TEST(OpenedGaps, IceWithoutHolesHasNoGapsAndMeasuresTheSame) {
   test::SlabSpec spec;
   spec.noise_over_spacing = 0.2;
@@ -83,7 +117,7 @@ TEST(OpenedGaps, IceWithoutHolesHasNoGapsAndMeasuresTheSame) {
   for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(a.crevasses[i].depth_m, b.crevasses[i].depth_m) << i;
   std::vector<std::array<double, 2>> bed;
   for (double x = -10.0; x <= 2010.0; x += 5.0) bed.push_back({x, spec.base_z(x)});
-  EXPECT_EQ(find_opened_gaps(s.x, s.z, a.surface, bed, 10.0, 5.0).cell_count, 0u);
+  EXPECT_EQ(find_opened_gaps(s.x, s.z, std::vector<std::uint8_t>(s.size(), 1), a.surface, bed, 10.0, 5.0).cell_count, 0u);
 }
 
 }  // namespace
