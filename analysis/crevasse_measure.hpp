@@ -54,11 +54,12 @@ struct MeasureSettings {
   //   "drop":  the source study's rule: both are kept, only the spacing between them is dropped
   //            and counted.
   std::string spacing_rule = "merge";
-  // Whether an opened gap inside the ice counts as part of a fracture (final and passed frames):
-  // a cell dx wide with no particle, below the bridged surface and above the bed, is filled with
-  // damaged points on the particle lattice before the clusters are found. A crack that has
-  // opened leaves intact ice on either side and empty cells between them, which the damaged
-  // particles alone do not link (docs/measurement.md, "Opened gaps").
+  // Whether an opened gap inside the ice counts as part of a fracture (every frame but the
+  // gate's): a cell dx wide with no particle, below the bridged surface and above the bed, in a
+  // patch of such cells that borders damaged ice, is filled with damaged points on the particle
+  // lattice before the clusters are found. A crack that has opened leaves intact ice on either
+  // side and empty cells between them, which the damaged particles alone do not link
+  // (docs/measurement.md, "Opened gaps").
   bool count_gaps = false;
   // Whether one damaged cluster that reaches the surface along a damaged skin (a surface layer
   // that lost its strength as the ice stretched) is read as the separate cracks that hang
