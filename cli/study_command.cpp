@@ -12,6 +12,7 @@
 #include "cli/cli_common.hpp"
 #include "cli/progress_printer.hpp"
 #include "engine/error.hpp"
+#include "study/engine_case.hpp"
 #include "study/kept_runs.hpp"
 #include "study/runner.hpp"
 #include "study/shard.hpp"
@@ -173,8 +174,7 @@ int study_command(const StudyCommandOptions& opt) {
                                     const std::vector<std::string>& tails) {
     std::vector<std::string> names;
     for (const StudyCase& c : study.cases) {
-      char stem[32];
-      std::snprintf(stem, sizeof stem, "case_%03zu_", c.index);
+      const std::string stem = case_file_stem(c.index);
       for (const std::string& tail : tails) names.push_back(stem + tail);
     }
     check_output_directory(option, dir, names);

@@ -59,12 +59,6 @@ void write_side_files(CaseContext& ctx, const std::filesystem::path& dir, const 
   }
 }
 
-// case_NNN_ (NNN as --dry-run lists the cases), the stem of every file a case writes.
-std::string case_file_stem(std::size_t index) {
-  char stem[32];
-  std::snprintf(stem, sizeof stem, "case_%03zu_", index);
-  return stem;
-}
 
 class CaseObserver : public RunObserver {
  public:
@@ -163,6 +157,12 @@ void check_finite(const ParticleSnapshot& s) {
 }
 
 }  // namespace
+
+std::string case_file_stem(std::size_t index) {
+  char stem[32];
+  std::snprintf(stem, sizeof stem, "case_%03zu_", index);
+  return stem;
+}
 
 nlohmann::json particle_file_metadata(const SceneConfig& scene, const analysis::MeasureSettings& measurement,
                                      const std::string& case_id, const std::string& label) {
