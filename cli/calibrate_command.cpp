@@ -201,6 +201,7 @@ std::vector<Answer> invert_in_every_regime(const StudyLaws& laws,
 // one row per site and regime that answers (or one row saying why none does).
 int calibrate_observations(const CalibrateCommandOptions& opt) {
   const std::vector<FieldObservation> sites = load_field_observations(opt.observations_path);
+  const std::vector<LiteratureStrength> literature = load_literature_strengths(opt.observations_path);
   const StudyLaws laws = load_laws(opt.db_path);
   const analysis::CalibrationOptions options = calibration_options(laws, opt.level);
   print_header(laws, opt.level);
@@ -280,6 +281,15 @@ int calibrate_observations(const CalibrateCommandOptions& opt) {
   std::printf("\nc from the inverted law with its %.0f %% interval (fit uncertainty and the site's spread); "
               "Pi = c/(rho_i g H_i); a site is in a regime when its Pi lies in the regime's Pi range\n",
               100.0 * opt.level);
+  if (!literature.empty()) {
+    std::printf("\ntensile strengths reported in the literature (%s):\n", opt.observations_path.c_str());
+    std::printf("%-36s %16s  %s\n", "id", "c[kPa]", "method");
+    for (const LiteratureStrength& s : literature) {
+      const std::string value = s.low_kpa == s.high_kpa ? short_number(s.low_kpa)
+                                                        : range(s.low_kpa, s.high_kpa);
+      std::printf("%-36s %16s  %s\n", s.id.c_str(), value.c_str(), s.method.c_str());
+    }
+  }
   return 0;
 }
 

@@ -35,3 +35,6 @@ done
 $C plot $R/regime_initiation.db --out $R/regime_initiation_figures --cdf-normalise bending --cdf-cases 12 13 6 16
 $C plot $R/regime_steady.db --out $R/regime_steady_figures --cdf-normalise bending --cdf-cases 1 2 4 12
 $C plot $R/regime_initiation_geometry.db --out $R/regime_initiation_geometry_figures --cdf-normalise bending
+# The field sites against the initiation study's laws, with the literature strengths under the table.
+$C calibrate --db $R/regime_initiation.db --observations studies/field/observations.json \
+  --csv $R/regime_initiation_figures/field_calibration.csv > $R/regime_initiation_figures/field_calibration.txt

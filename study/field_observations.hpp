@@ -25,10 +25,24 @@ struct FieldObservation {
   std::string reference;
 };
 
+// A published tensile strength of ice (the file's `tensile_strength_literature`), shown beside
+// the calibrated strengths. A single value has low == high.
+struct LiteratureStrength {
+  std::string id;
+  double low_kpa = 0.0, high_kpa = 0.0;
+  std::string method;
+  std::string reference;
+};
+
 // Reads and checks the file. Throws InputError naming the entry and field (one line) for a
 // missing or malformed value, a non-positive spacing or thickness, a spread that does not hold
 // the spacing, or a repeated id.
 std::vector<FieldObservation> load_field_observations(const std::string& path);
+
+// The file's literature strengths (empty when it has none), checked like the sites: a one-line
+// InputError naming the entry and field for a missing text, a value outside (0, 1e6] kPa, low
+// above high, or a repeated id.
+std::vector<LiteratureStrength> load_literature_strengths(const std::string& path);
 
 // The observation as the calibration takes it. The spread becomes quartiles: given quartiles
 // as they are; else a standard deviation as spacing ± 0.674·sd (the quartiles of a normal

@@ -611,6 +611,39 @@ TEST(FitCli, CalibrateObservationsFile) {
       "--observations");
 }
 
+// The file's literature strengths are listed under the table, a range as [low, high] and a
+// single value as one number; a range upside down is refused before anything is printed.
+TEST(FitCli, CalibrateListsLiteratureStrengths) {
+  test::ScratchDir dir("fit");
+  write_synthetic_db(dir / "s.db", 10, {100.0, 200.0}, known_laws(0.05));
+  ASSERT_EQ(test::run_cli(dir.path(), "fit s.db").code, 0);
+  nlohmann::json file = {
+      {"observations",
+       {{{"id", "site"}, {"site", "A"}, {"spacing_median_m", 50.0}, {"spacing_statistic", "median"},
+         {"thickness_m", 150.0}, {"reference", "synthetic"}}}},
+      {"tensile_strength_literature",
+       {{{"id", "lab_range"}, {"value_kpa_low", 700.0}, {"value_kpa_high", 3100.0},
+         {"method", "lab tension"}, {"reference", "synthetic"}},
+        {{"id", "one_value"}, {"value_kpa_low", 1000.0}, {"value_kpa_high", 1000.0},
+         {"method", "field collapse"}, {"reference", "synthetic"}}}}};
+  std::ofstream(dir / "obs.json") << file.dump(2);
+  const test::CliResult r = test::run_cli(dir.path(), "calibrate --db s.db --observations obs.json");
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  const auto at = r.out.find("tensile strengths reported in the literature");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  const std::string listed = r.out.substr(at);
+  EXPECT_NE(listed.find("lab_range"), std::string::npos) << listed;
+  EXPECT_NE(listed.find("[700, 3100]"), std::string::npos) << listed;
+  EXPECT_NE(listed.find("one_value"), std::string::npos) << listed;
+  EXPECT_EQ(listed.find("[1000, 1000]"), std::string::npos) << listed;
+
+  file["tensile_strength_literature"][0]["value_kpa_high"] = 600.0;
+  std::ofstream(dir / "bad.json") << file.dump(2);
+  const test::CliResult bad = test::run_cli(dir.path(), "calibrate --db s.db --observations bad.json");
+  expect_one_line_error(bad, "tensile_strength_literature[0].value_kpa_high");
+  EXPECT_EQ(bad.out.find("site"), std::string::npos) << bad.out;
+}
+
 // The shipped field file is well formed (every entry passes the loader's checks).
 TEST(FitCli, ShippedObservationsFileLoads) {
   const auto sites =
@@ -620,6 +653,9 @@ TEST(FitCli, ShippedObservationsFileLoads) {
     EXPECT_GT(o.spacing_m, 0.0) << o.id;
     EXPECT_FALSE(o.reference.empty()) << o.id;
   }
+  const auto strengths = load_literature_strengths(std::string(CREVASSE_SOURCE_DIR) +
+                                                   "/studies/field/observations.json");
+  EXPECT_GE(strengths.size(), 3u);
 }
 
 }  // namespace
