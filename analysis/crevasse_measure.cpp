@@ -68,6 +68,7 @@ struct ClusterTally {
   double surface_x_min = std::numeric_limits<double>::infinity();
   double surface_x_max = -std::numeric_limits<double>::infinity();
   bool under_skin = false;  // an opening of a cluster read as cracks under a damaged skin
+  bool placed_by_gaps = false;  // no damaged particle reaches the surface: an opened top
 };
 
 // A crevasse during merging: its x-extent at the surface is kept to form the union.
@@ -462,6 +463,8 @@ CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
     tally.resize(tally.size() + bounds[c].size() + 1);
     if (!cracks[c].empty())
       for (std::size_t k = first[c]; k < tally.size(); ++k) tally[k].under_skin = true;
+    if (!placed_by_particles[c])
+      for (std::size_t k = first[c]; k < tally.size(); ++k) tally[k].placed_by_gaps = true;
     for (double x : xs) {
       const auto k = static_cast<std::size_t>(std::upper_bound(bounds[c].begin(), bounds[c].end(), x) -
                                               bounds[c].begin());
@@ -511,6 +514,9 @@ CrevasseMeasurement measure_in_frame(const ParticleSnapshot& snapshot,
     c.crevasse.depth_m = std::clamp(c.crevasse.surface_z_m - c.crevasse.bottom_z_m, 0.0, r.ice_thickness_m);
     c.crevasse.particle_count = t.particle_count;
     c.crevasse.width_m = c.right_m - c.left_m;
+    // An opened top is the mouth of a crack, deeper than it is wide; a gap wider than it is
+    // deep is the surface sagging between two blocks beside a crack's lip, not a crack.
+    if (t.placed_by_gaps && c.crevasse.depth_m < c.crevasse.width_m) continue;
     candidates.push_back(c);
   }
   std::sort(candidates.begin(), candidates.end(),

@@ -5,6 +5,7 @@
 #include <set>
 
 #include "engine/error.hpp"
+#include "analysis/measurement_io.hpp"
 #include "engine/particle_file.hpp"
 #include "study/case_hash.hpp"
 #include "study/engine_case.hpp"
@@ -154,7 +155,9 @@ CaseOutcome KeptRuns::operator()(const StudyCase& study_case, CaseContext& ctx) 
   out.sim_time_s = result.at("sim_time_s").get<double>();
   out.result_extra = result.at("extra");
   out.result_extra.erase("other_spacing_rule");  // measured again below
-  out.result_extra.erase("over_time");  // taken in the old measurement's frame
+  nlohmann::json over_time = nullptr;
+  if (out.result_extra.contains("over_time")) over_time = out.result_extra["over_time"];
+  out.result_extra.erase("over_time");
   out.run_json = run;
   out.run_json.erase("peak_rss_exact");  // the runner's, for this process
   out.run_json["measured_from"] = {
@@ -162,6 +165,14 @@ CaseOutcome KeptRuns::operator()(const StudyCase& study_case, CaseContext& ctx) 
   if (!kept->gate_mark.is_null())
     out.run_json["measured_from"]["kept_at_gate_mark_of_case_id"] = kept->gate_mark.value("of_case_id", "");
   measure_final_state(study_case, ctx, file.snapshot, out);
+  // The field over time was measured as the run went: it stays when the settings are the run's
+  // own (the same study measured again by a newer detector), not when they differ.
+  if (!over_time.is_null() && kept->gate_mark.is_null() && out.measurement &&
+      result.contains("measurement") && result["measurement"].contains("settings") &&
+      result["measurement"]["settings"] == analysis::measurement_summary_json(*out.measurement)["settings"]) {
+    out.result_extra["over_time"] = std::move(over_time);
+    out.run_json["over_time_measured_during_run"] = true;
+  }
   return out;
 }
 

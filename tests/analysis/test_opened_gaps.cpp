@@ -104,6 +104,28 @@ TEST(OpenedGaps, ANotchBesideACrackDoesNotMoveIt) {
   EXPECT_NEAR(with.crevasses[0].depth_m, without.crevasses[0].depth_m, 5.0);
 }
 
+// Where no damaged particle reaches the surface, the gap above damaged ice places the crevasse:
+// the opened mouth of a crack, deeper than it is wide. A sag of the surface over damaged ice,
+// wider than it is deep (two blocks tilted beside a crack's lip), is not a crack.
+TEST(OpenedGaps, AnOpenedMouthIsDeeperThanWideASagIsNot) {
+  test::SlabSpec spec;
+  spec.thickness_m = 200.0;
+  // A crack damaged from 60 to 100 m below the surface, open above: a mouth 20 m wide.
+  ParticleSnapshot mouth = test::make_slab(spec, {{600.0, 100.0, 20.0, 60.0}});
+  open_gap(mouth, 590.0, 610.0, 140.0, 200.0);
+  // A sag 90 m wide and 35 m deep over a damaged layer 10 m thick.
+  ParticleSnapshot sag = test::make_slab(spec, {{1045.0, 45.0, 90.0, 35.0}});
+  open_gap(sag, 1000.0, 1090.0, 165.0, 200.0);
+  const CrevasseMeasurement m = measure_crevasses(mouth, final_frame(true));
+  ASSERT_EQ(m.crevasses.size(), 1u);
+  EXPECT_NEAR(m.crevasses[0].x_m, 600.0, 10.0);
+  EXPECT_NEAR(m.crevasses[0].depth_m, 100.0, 10.0);
+  const CrevasseMeasurement g = measure_crevasses(sag, final_frame(true));
+  EXPECT_TRUE(g.crevasses.empty()) << g.crevasses.size() << " crevasse(s), the first "
+                                   << (g.crevasses.empty() ? 0.0 : g.crevasses[0].depth_m) << " m deep, "
+                                   << (g.crevasses.empty() ? 0.0 : g.crevasses[0].width_m) << " m wide";
+}
+
 TEST(OpenedGaps, IceWithoutHolesHasNoGapsAndMeasuresTheSame) {
   test::SlabSpec spec;
   spec.noise_over_spacing = 0.2;

@@ -586,6 +586,39 @@ TEST(Cli, RemeasureFromKeptParticlesStoresWhatAFullRunStores) {
   EXPECT_FALSE(std::filesystem::exists(dir / "x.db")) << "refused, yet the study began";
 }
 
+// The field over time is measured as a run goes and cannot be taken again from the final
+// particles. Measured again with the run's own settings (a newer detector on the same study),
+// a case keeps it, and then stores the very record the run stored; with other settings it is
+// dropped, being another measurement's.
+TEST(Cli, RemeasureKeepsTheFieldOverTimeOnlyUnderTheRunsOwnSettings) {
+  test::ScratchDir dir("cli");
+  nlohmann::json kept = test::tiny_study(2, 200, "kept");
+  kept["base_scene"]["run"] = {{"end_time", 30.0}};
+  kept["measure_interval_s"] = 10.0;
+  test::write_text(dir / "kept.json", kept.dump(2));
+  ASSERT_EQ(run_cli(dir.path(), "study kept.json --db kept.db --keep-particles --quiet").code, 0);
+  const char* over_time = "SELECT case_index, json_extract(result_json, '$.extra.over_time') FROM cases ORDER BY case_index";
+  const auto series = test::dump_rows(dir / "kept.db", over_time);
+  ASSERT_EQ(series.size(), 2u);
+  for (const auto& row : series) ASSERT_GT(row.size(), 20u) << "no field over time stored: the test shows nothing";
+
+  const Result same = run_cli(dir.path(), "study kept.json --db same.db --remeasure kept.db --particles-from kept.db.particles --quiet");
+  ASSERT_EQ(same.code, 0) << same.err;
+  EXPECT_EQ(test::dump_rows(dir / "same.db", over_time), series);
+  const char* records = "SELECT case_id, result_json, result_hash FROM cases ORDER BY case_id";
+  EXPECT_EQ(test::dump_rows(dir / "same.db", records), test::dump_rows(dir / "kept.db", records));
+  EXPECT_EQ(test::dump_rows(dir / "same.db", "SELECT count(*) FROM cases WHERE "
+                                             "json_extract(run_json, '$.over_time_measured_during_run')")[0], "2");
+
+  nlohmann::json other = kept;
+  other["name"] = "other";
+  other["measurement"] = {{"min_depth_over_dx", 1.0}};
+  test::write_text(dir / "other.json", other.dump(2));
+  ASSERT_EQ(run_cli(dir.path(), "study other.json --db other.db --remeasure kept.db --particles-from kept.db.particles --quiet").code, 0);
+  EXPECT_EQ(test::dump_rows(dir / "other.db", "SELECT count(*) FROM cases WHERE "
+                                              "json_extract(result_json, '$.extra.over_time') IS NULL")[0], "2");
+}
+
 // One run serves a shorter protocol: a study whose cases keep their particles when 1.05 H_i has
 // passed the gate (keep_particles_at_gate_length_ratios, a ratio with no exact binary form) lets
 // --remeasure fill the study that stops there, storing exactly what running that study stores,
