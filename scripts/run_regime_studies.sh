@@ -7,10 +7,13 @@
 #   nohup bash scripts/run_regime_studies.sh > regime.log 2>&1 &
 #
 # 1. the steady study, which keeps each case's particles at 1.25, 2 and 3 H_i through the gate;
-# 2. the initiation study's 800 m cases at the Π the two share, measured from those particles
-#    (the same result hashes as running them); its 400 m cases ran as initiation cases;
-# 3. the initiation study's other cases, then its replicas and its geometry companion;
-# 4. fits and figures of each.
+# 2. the initiation study's cases at 400 and 800 m at the Π the two share, and the geometry
+#    study's two cases on the same scene, measured from those particles at 2 H_i (the same result
+#    hashes as running them);
+# 3. the initiation study's other cases, its replicas, and the geometry study's cases that vary
+#    one of S and L_s/H_i at a time;
+# 4. fits, figures and the field calibration;
+# 5. the rest of the geometry study (S and L_s/H_i together).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cmake --build build -j "$(nproc)" --target crevasse
@@ -18,14 +21,18 @@ C=./build/cli/crevasse
 R=results
 
 $C study studies/regime_steady.json --db $R/regime_steady.db --keep-particles --views $R/regime_steady_views
-# Cases 31-33 and 35-39 (as --dry-run lists them): H_i = 800 m at Π = 0.05-1 but 0.125.
-$C study studies/regime_initiation.json --db $R/regime_initiation.db --cases 31-33,35-39 \
+# As --dry-run lists them: initiation cases 11-13, 15-19 (400 m) and 31-33, 35-39 (800 m), Π =
+# 0.05-1 but 0.0375 and 0.125; geometry cases 8, 9 (S = 1/2, L_s = H_i, the same scene).
+$C study studies/regime_initiation.json --db $R/regime_initiation.db --cases 11-13,15-19,31-33,35-39 \
   --remeasure $R/regime_steady.db --particles-from $R/regime_steady.db.particles --views $R/regime_initiation_views
+$C study studies/regime_initiation_geometry.json --db $R/regime_initiation_geometry.db --cases 8,9 \
+  --remeasure $R/regime_steady.db --particles-from $R/regime_steady.db.particles --views $R/regime_initiation_geometry_views
 $C study studies/regime_initiation.json --db $R/regime_initiation.db --keep-particles --views $R/regime_initiation_views
 $C study studies/regime_initiation_replicas.json --db $R/regime_initiation_replicas.db --keep-particles \
   --views $R/regime_initiation_replicas_views
-$C study studies/regime_initiation_geometry.json --db $R/regime_initiation_geometry.db --keep-particles \
-  --views $R/regime_initiation_geometry_views
+# S = 0.2, 1 at L_s = H_i and L_s/H_i = 0.5, 2 at S = 1/2, at both Π.
+$C study studies/regime_initiation_geometry.json --db $R/regime_initiation_geometry.db --cases 2,3,6,7,10,11,14,15 \
+  --keep-particles --views $R/regime_initiation_geometry_views
 
 for s in regime_steady regime_initiation regime_initiation_geometry; do
   $C fit $R/$s.db
@@ -38,3 +45,8 @@ $C plot $R/regime_initiation_geometry.db --out $R/regime_initiation_geometry_fig
 # The field sites against the initiation study's laws, with the literature strengths under the table.
 $C calibrate --db $R/regime_initiation.db --observations studies/field/observations.json \
   --csv $R/regime_initiation_figures/field_calibration.csv > $R/regime_initiation_figures/field_calibration.txt
+# The rest of the geometry study: S and L_s/H_i varied together.
+$C study studies/regime_initiation_geometry.json --db $R/regime_initiation_geometry.db --keep-particles \
+  --views $R/regime_initiation_geometry_views
+$C fit $R/regime_initiation_geometry.db
+$C plot $R/regime_initiation_geometry.db --out $R/regime_initiation_geometry_figures --cdf-normalise bending
