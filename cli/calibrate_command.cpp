@@ -200,8 +200,9 @@ std::vector<Answer> invert_in_every_regime(const StudyLaws& laws,
 // `crevasse calibrate --observations FILE`: every site of the file against the study's laws,
 // one row per site and regime that answers (or one row saying why none does).
 int calibrate_observations(const CalibrateCommandOptions& opt) {
-  const std::vector<FieldObservation> sites = load_field_observations(opt.observations_path);
-  const std::vector<LiteratureStrength> literature = load_literature_strengths(opt.observations_path);
+  const FieldObservationFile file = load_field_observations(opt.observations_path);
+  const std::vector<FieldObservation>& sites = file.sites;
+  const std::vector<LiteratureStrength>& literature = file.literature;
   const StudyLaws laws = load_laws(opt.db_path);
   const analysis::CalibrationOptions options = calibration_options(laws, opt.level);
   print_header(laws, opt.level);

@@ -13,7 +13,7 @@
 # 3. the initiation study's other cases, its replicas, and the geometry study's cases that vary
 #    one of S and L_s/H_i at a time;
 # 4. fits, figures and the field calibration;
-# 5. the rest of the geometry study (S and L_s/H_i together).
+# 5. the rest of the geometry study (S and L_s/H_i together), then its fits and figures.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cmake --build build -j "$(nproc)" --target crevasse
@@ -34,18 +34,17 @@ $C study studies/regime_initiation_replicas.json --db $R/regime_initiation_repli
 $C study studies/regime_initiation_geometry.json --db $R/regime_initiation_geometry.db --cases 2,3,6,7,10,11,14,15 \
   --keep-particles --views $R/regime_initiation_geometry_views
 
-for s in regime_steady regime_initiation regime_initiation_geometry; do
+for s in regime_steady regime_initiation; do
   $C fit $R/$s.db
 done
 # CDFs of two cases per regime (cases 12, 13: H_i = 400 m, Π = 0.075, 0.1; 6, 16: Π = 0.2 at 200
 # and 400 m); the steady study's likewise (cases 1, 2 and 4: Π = 0.075, 0.1, 0.2 at 400 m, and 12: 0.2 at 800 m).
 $C plot $R/regime_initiation.db --out $R/regime_initiation_figures --cdf-normalise bending --cdf-cases 12 13 6 16
 $C plot $R/regime_steady.db --out $R/regime_steady_figures --cdf-normalise bending --cdf-cases 1 2 4 12
-$C plot $R/regime_initiation_geometry.db --out $R/regime_initiation_geometry_figures --cdf-normalise bending
 # The field sites against the initiation study's laws, with the literature strengths under the table.
 $C calibrate --db $R/regime_initiation.db --observations studies/field/observations.json \
   --csv $R/regime_initiation_figures/field_calibration.csv > $R/regime_initiation_figures/field_calibration.txt
-# The rest of the geometry study: S and L_s/H_i varied together.
+# The rest of the geometry study, S and L_s/H_i varied together; then its fits and figures.
 $C study studies/regime_initiation_geometry.json --db $R/regime_initiation_geometry.db --keep-particles \
   --views $R/regime_initiation_geometry_views
 $C fit $R/regime_initiation_geometry.db

@@ -59,7 +59,6 @@ void write_side_files(CaseContext& ctx, const std::filesystem::path& dir, const 
   }
 }
 
-
 class CaseObserver : public RunObserver {
  public:
   CaseObserver(const StudyCase& study_case, CaseContext& ctx)

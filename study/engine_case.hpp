@@ -19,10 +19,11 @@ CaseOutcome run_engine_case(const StudyCase& study_case, CaseContext& ctx);
 void measure_final_state(const StudyCase& study_case, CaseContext& ctx, const ParticleSnapshot& final_snapshot,
                          CaseOutcome& out);
 
-// What a kept particle file carries besides the particles (engine/particle_file.hpp): the case,
-// ρ_i and g (for Π), and the study's measurement settings, which `crevasse measure` starts from.
 // case_NNN_ (NNN as --dry-run lists the cases), the stem of every file a case writes.
 std::string case_file_stem(std::size_t index);
+
+// What a kept particle file carries besides the particles (engine/particle_file.hpp): the case,
+// ρ_i and g (for Π), and the study's measurement settings, which `crevasse measure` starts from.
 nlohmann::json particle_file_metadata(const SceneConfig& scene, const analysis::MeasureSettings& measurement,
                                       const std::string& case_id, const std::string& label);
 

@@ -50,15 +50,45 @@ std::optional<std::pair<double, double>> pair_around(const json& e, const std::s
   return std::make_pair(lo, hi);
 }
 
+std::vector<LiteratureStrength> literature_strengths(const json& doc, const std::string& path) {
+  std::vector<LiteratureStrength> out;
+  if (!doc.contains("tensile_strength_literature")) return out;
+  const json& list = doc["tensile_strength_literature"];
+  const std::string name = path + ": tensile_strength_literature";
+  if (!list.is_array()) throw InputError(name + ": must be an array of entries");
+  std::set<std::string> ids;
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    const std::string entry = name + "[" + std::to_string(k) + "]";
+    const json& e = list[k];
+    if (!e.is_object()) throw InputError(entry + " must be an object");
+    refuse_unknown_keys(e, entry,
+                        {"id", "value_kpa_low", "value_kpa_high", "method", "reference",
+                         "where_in_reference", "read_at", "notes"});
+    LiteratureStrength s;
+    s.id = text(e, "id", entry + ".id", true);
+    if (!ids.insert(s.id).second) throw InputError(entry + ".id: '" + s.id + "' is repeated");
+    s.low_kpa = positive_number(e, "value_kpa_low", entry + ".value_kpa_low");
+    s.high_kpa = positive_number(e, "value_kpa_high", entry + ".value_kpa_high");
+    if (s.high_kpa < s.low_kpa)
+      throw InputError(entry + ".value_kpa_high: " + short_number(s.high_kpa) + " is below value_kpa_low " +
+                       short_number(s.low_kpa) + " (need low <= high)");
+    s.method = text(e, "method", entry + ".method", true);
+    s.reference = text(e, "reference", entry + ".reference", true);
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
 }  // namespace
 
-std::vector<FieldObservation> load_field_observations(const std::string& path) {
+FieldObservationFile load_field_observations(const std::string& path) {
   const json doc = parse_json_input<json>(read_input_file(path, "--observations"), path);
   if (!doc.is_object() || !doc.contains("observations") || !doc["observations"].is_array() ||
       doc["observations"].empty())
     throw InputError(path + ": observations: needs a non-empty array of sites");
   refuse_unknown_keys(doc, path, {"description", "observations", "tensile_strength_literature"});
-  std::vector<FieldObservation> out;
+  FieldObservationFile file;
+  std::vector<FieldObservation>& out = file.sites;
   std::set<std::string> ids;
   const json& list = doc["observations"];
   for (std::size_t k = 0; k < list.size(); ++k) {
@@ -89,37 +119,8 @@ std::vector<FieldObservation> load_field_observations(const std::string& path) {
       o.thickness_m = positive_number(e, "thickness_m", where(path, k, "thickness_m"));
     out.push_back(std::move(o));
   }
-  return out;
-}
-
-std::vector<LiteratureStrength> load_literature_strengths(const std::string& path) {
-  const json doc = parse_json_input<json>(read_input_file(path, "--observations"), path);
-  std::vector<LiteratureStrength> out;
-  if (!doc.is_object() || !doc.contains("tensile_strength_literature")) return out;
-  const json& list = doc["tensile_strength_literature"];
-  const std::string name = path + ": tensile_strength_literature";
-  if (!list.is_array()) throw InputError(name + ": must be an array of entries");
-  std::set<std::string> ids;
-  for (std::size_t k = 0; k < list.size(); ++k) {
-    const std::string at = name + "[" + std::to_string(k) + "].";
-    const json& e = list[k];
-    if (!e.is_object()) throw InputError(name + "[" + std::to_string(k) + "] must be an object");
-    refuse_unknown_keys(e, name + "[" + std::to_string(k) + "]",
-                        {"id", "value_kpa_low", "value_kpa_high", "method", "reference",
-                         "where_in_reference", "read_at", "notes"});
-    LiteratureStrength s;
-    s.id = text(e, "id", at + "id", true);
-    if (!ids.insert(s.id).second) throw InputError(at + "id: '" + s.id + "' is repeated");
-    s.low_kpa = positive_number(e, "value_kpa_low", at + "value_kpa_low");
-    s.high_kpa = positive_number(e, "value_kpa_high", at + "value_kpa_high");
-    if (s.high_kpa < s.low_kpa)
-      throw InputError(at + "value_kpa_high: " + short_number(s.high_kpa) + " is below value_kpa_low " +
-                       short_number(s.low_kpa) + " (need low <= high)");
-    s.method = text(e, "method", at + "method", true);
-    s.reference = text(e, "reference", at + "reference", true);
-    out.push_back(std::move(s));
-  }
-  return out;
+  file.literature = literature_strengths(doc, path);
+  return file;
 }
 
 analysis::SpacingObservation to_spacing_observation(const FieldObservation& o, std::string* spread) {

@@ -34,15 +34,16 @@ struct LiteratureStrength {
   std::string reference;
 };
 
+struct FieldObservationFile {
+  std::vector<FieldObservation> sites;
+  std::vector<LiteratureStrength> literature;  // empty when the file has none
+};
+
 // Reads and checks the file. Throws InputError naming the entry and field (one line) for a
 // missing or malformed value, a non-positive spacing or thickness, a spread that does not hold
-// the spacing, or a repeated id.
-std::vector<FieldObservation> load_field_observations(const std::string& path);
-
-// The file's literature strengths (empty when it has none), checked like the sites: a one-line
-// InputError naming the entry and field for a missing text, a value outside (0, 1e6] kPa, low
-// above high, or a repeated id.
-std::vector<LiteratureStrength> load_literature_strengths(const std::string& path);
+// the spacing, a literature strength outside (0, 1e6] kPa or with its low above its high, or a
+// repeated id.
+FieldObservationFile load_field_observations(const std::string& path);
 
 // The observation as the calibration takes it. The spread becomes quartiles: given quartiles
 // as they are; else a standard deviation as spacing ± 0.674·sd (the quartiles of a normal

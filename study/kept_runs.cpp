@@ -4,8 +4,8 @@
 #include <cctype>
 #include <set>
 
-#include "engine/error.hpp"
 #include "analysis/measurement_io.hpp"
+#include "engine/error.hpp"
 #include "engine/particle_file.hpp"
 #include "study/case_hash.hpp"
 #include "study/engine_case.hpp"
@@ -155,9 +155,7 @@ CaseOutcome KeptRuns::operator()(const StudyCase& study_case, CaseContext& ctx) 
   out.sim_time_s = result.at("sim_time_s").get<double>();
   out.result_extra = result.at("extra");
   out.result_extra.erase("other_spacing_rule");  // measured again below
-  nlohmann::json over_time = nullptr;
-  if (out.result_extra.contains("over_time")) over_time = out.result_extra["over_time"];
-  out.result_extra.erase("over_time");
+  out.result_extra.erase("over_time");             // kept below when still the run's own
   out.run_json = run;
   out.run_json.erase("peak_rss_exact");  // the runner's, for this process
   out.run_json["measured_from"] = {
@@ -167,10 +165,12 @@ CaseOutcome KeptRuns::operator()(const StudyCase& study_case, CaseContext& ctx) 
   measure_final_state(study_case, ctx, file.snapshot, out);
   // The field over time was measured as the run went: it stays when the settings are the run's
   // own (the same study measured again by a newer detector), not when they differ.
-  if (!over_time.is_null() && kept->gate_mark.is_null() && out.measurement &&
-      result.contains("measurement") && result["measurement"].contains("settings") &&
-      result["measurement"]["settings"] == analysis::measurement_summary_json(*out.measurement)["settings"]) {
-    out.result_extra["over_time"] = std::move(over_time);
+  const nlohmann::json& extra = result.at("extra");
+  const bool own_settings =
+      kept->gate_mark.is_null() && out.measurement && result.contains("measurement") &&
+      result["measurement"].value("settings", nlohmann::json()) == analysis::settings_to_json(out.measurement->settings);
+  if (own_settings && extra.contains("over_time")) {
+    out.result_extra["over_time"] = extra["over_time"];
     out.run_json["over_time_measured_during_run"] = true;
   }
   return out;
