@@ -138,10 +138,13 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
 
   // The cases drawn: the study's own, then those of --add-cases (label prefix, not fitted).
   std::vector<std::vector<CaseRecord>> added;
-  std::vector<std::string> added_names;
+  std::vector<std::string> added_names;   // in the title
+  std::vector<std::string> added_legend;  // before each added case's legend entry: which field it is
   for (const std::string& path : opt.add_cases) {
     Store other = Store::open_reader(path);
     added_names.push_back(study_name(other, path));
+    const std::string label = study_field_label(other);
+    added_legend.push_back(added_names.back() + (label.empty() ? std::string() : " (" + label + ")"));
     added.push_back(read_case_records(other));
   }
   // The fits table is read while drawing; an inconsistent row is refused here, before the folder.
@@ -152,7 +155,7 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
   for (const CaseRecord& c : cases) drawn_cases.emplace_back(&c, "");
   for (std::size_t k = 0; k < added.size(); ++k)
     for (const CaseRecord& c : added[k])
-      drawn_cases.emplace_back(&c, analysis::escape_markup(added_names[k]) + ": ");
+      drawn_cases.emplace_back(&c, analysis::escape_markup(added_legend[k]) + ": ");
 
   std::vector<fs::path> written;
   for (Quantity q : kQuantities) {

@@ -8,8 +8,8 @@
 # The cheap cases go first, so that the initiation study covers H_i = 200-600 m with its replicas
 # and the step's shape before the long steady row at 800 m (about 4 h per case on one thread):
 # 1. the replicas, and the geometry study's cases at S = 1/2, L_s = H_i measured from the steady
-#    runs' particles at 2 H_i (the same result hashes as running them: docs/model.md, "Two
-#    protocols"), then its cases that vary one of S and L_s/H_i at a time;
+#    runs' particles at 2 H_i (the cases a run would store, without the field over time:
+#    docs/model.md, "Two protocols"), then its cases that vary one of S and L_s/H_i at a time;
 # 2. the initiation study's cases the steady study does not serve (H_i = 200, 600 m, and
 #    Π = 0.0375, 0.125 at 800 m); fits, figures and the field calibration;
 # 3. the steady study, which keeps each case's particles at 1.25, 2 and 3 H_i through the gate, and

@@ -389,23 +389,27 @@ TEST(FitCli, StatusGivesTheShareOfCrevassesDeeperThanHalfTheIce) {
   EXPECT_EQ(share["1"], "100%") << status.out;
 }
 
-// --add-cases draws another study's cases on the diagram under their study's name, without
-// fitting them (the fit line and its n stay those of the study).
+// --add-cases draws another study's cases on the diagram under their study's name and field
+// (protocol and frame), without fitting them (the fit line and its n stay those of the study).
 TEST(FitCli, PlotAddsCasesOfAnotherStudy) {
   test::ScratchDir dir("fit");
   write_synthetic_db(dir / "s.db", 8, {100.0}, known_laws(0.05));
-  write_synthetic_db(dir / "other.db", 3, {300.0}, [](const StudyCase&) {
-    FakeResult f;
-    f.spacing_over_h = 50.0;  // far off the law: would move the fit if it were fitted
-    f.depth_over_h = 1.0;
-    return f;
-  });
+  write_synthetic_db(
+      dir / "other.db", 3, {300.0},
+      [](const StudyCase&) {
+        FakeResult f;
+        f.spacing_over_h = 50.0;  // far off the law: would move the fit if it were fitted
+        f.depth_over_h = 1.0;
+        return f;
+      },
+      [](nlohmann::json& j) { j["protocol"] = "steady"; });
   ASSERT_EQ(test::run_cli(dir.path(), "plot s.db --out alone").code, 0);
   const test::CliResult plot = test::run_cli(dir.path(), "plot s.db --out both --add-cases other.db");
   ASSERT_EQ(plot.code, 0) << plot.err;
   EXPECT_NE(plot.out.find("11 case(s) drawn"), std::string::npos) << plot.out;
   const std::string svg = test::read_file(dir / "both" / "spacing_vs_cohesion_ratio.svg");
-  EXPECT_NE(svg.find("legend: synthetic: H_i = 300 m"), std::string::npos);
+  EXPECT_NE(svg.find("legend: synthetic (steady protocol, passed frame): H_i = 300 m"), std::string::npos)
+      << svg.substr(0, 2000);
   // The fitted law printed on the figure is the same with and without the added cases.
   const auto law = [](const std::string& text) {
     const auto at = text.find("b = ");
