@@ -91,7 +91,7 @@ def show(rows, a):
             continue
         ot = (json.loads(rj or "{}").get("extra") or {}).get("over_time") or []
         if not ot:
-            print(f"case {idx}: no over_time (run with measure_interval_s)")
+            print(f"case {idx}: no over_time (run without measure_interval_s, or stored from particles kept at a gate mark)")
             continue
         k = settled_from(ot, h, a.tolerance_cracks, tol_len)
         counted = f"count within {a.tolerance_cracks}, " if a.tolerance_cracks >= 0 else ""
