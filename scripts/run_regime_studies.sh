@@ -21,15 +21,16 @@ cmake --build build -j "$(nproc)" --target crevasse
 C=./build/cli/crevasse
 R=results
 
+# Arguments: the steady study's cases whose CDFs are drawn (only cases that are done).
 fit_and_plot() {
   for s in regime_steady regime_initiation; do
     $C fit $R/$s.db
   done
   # CDFs of two cases per regime (cases 12, 13: H_i = 400 m, Π = 0.075, 0.1; 6, 16: Π = 0.2 at 200
   # and 400 m); the steady study's likewise (cases 1, 2 and 4: Π = 0.075, 0.1, 0.2 at 400 m, and
-  # 12: 0.2 at 800 m).
+  # once its 800 m row has run 12: 0.2 at 800 m).
   $C plot $R/regime_initiation.db --out $R/regime_initiation_figures --cdf-normalise bending --cdf-cases 12 13 6 16
-  $C plot $R/regime_steady.db --out $R/regime_steady_figures --cdf-normalise bending --cdf-cases 1 2 4 12
+  $C plot $R/regime_steady.db --out $R/regime_steady_figures --cdf-normalise bending --cdf-cases "$@"
   # The field sites against the initiation study's laws, with the literature strengths under the table.
   $C calibrate --db $R/regime_initiation.db --observations studies/field/observations.json \
     --csv $R/regime_initiation_figures/field_calibration.csv > $R/regime_initiation_figures/field_calibration.txt
@@ -49,13 +50,13 @@ done
 # As --dry-run lists them: 20-29 the 600 m row, 30 and 34 Π = 0.0375, 0.125 at 800 m.
 $C study studies/regime_initiation.json --db $R/regime_initiation.db --cases 0-10,14,20-30,34 --keep-particles \
   --views $R/regime_initiation_views
-fit_and_plot
+fit_and_plot 1 2 4
 
 $C study studies/regime_steady.json --db $R/regime_steady.db --keep-particles --views $R/regime_steady_views
 # The initiation cases at 400 and 800 m at the Π the two studies share (11-13, 15-19, 31-33, 35-39).
 $C study studies/regime_initiation.json --db $R/regime_initiation.db --cases 11-13,15-19,31-33,35-39 \
   --remeasure $R/regime_steady.db --particles-from $R/regime_steady.db.particles --views $R/regime_initiation_views
-fit_and_plot
+fit_and_plot 1 2 4 12
 
 # The rest of the geometry study, S and L_s/H_i together; then its fits and figures.
 $C study studies/regime_initiation_geometry.json --db $R/regime_initiation_geometry.db --keep-particles \
