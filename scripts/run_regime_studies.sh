@@ -6,7 +6,7 @@
 #   nohup bash scripts/run_regime_studies.sh > regime.log 2>&1 &
 #
 # The cheap cases go first, so that the initiation study covers H_i = 200-600 m with its replicas
-# and the step's shape before the long steady row at 800 m (about 4 h per case on one thread):
+# and the step's shape before the long steady row at 800 m (about 2.5 h per case on one thread):
 # 1. the replicas, and the geometry study's cases at S = 1/2, L_s = H_i measured from the steady
 #    runs' particles at 2 H_i (the cases a run would store, without the field over time:
 #    docs/model.md, "Two protocols"), then its cases that vary one of S and L_s/H_i at a time;
