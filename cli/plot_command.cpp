@@ -120,9 +120,7 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
 
   Store store = Store::open_reader(opt.db_path);
   const std::vector<CaseRecord> cases = read_case_records(store);
-  const std::string own_label = study_field_label(store);
-  const std::string own_name =
-      study_name(store, "study") + (own_label.empty() ? std::string() : " (" + own_label + ")");
+  const std::string own_name = study_name_with_field(store, "study");
   std::vector<const CaseRecord*> cdf_cases;
   for (std::int64_t index : opt.cdf_cases) {
     const auto it = std::find_if(cases.begin(), cases.end(),
@@ -143,8 +141,7 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
   for (const std::string& path : opt.add_cases) {
     Store other = Store::open_reader(path);
     added_names.push_back(study_name(other, path));
-    const std::string label = study_field_label(other);
-    added_legend.push_back(added_names.back() + (label.empty() ? std::string() : " (" + label + ")"));
+    added_legend.push_back(study_name_with_field(other, path));
     added.push_back(read_case_records(other));
   }
   // The fits table is read while drawing; an inconsistent row is refused here, before the folder.

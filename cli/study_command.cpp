@@ -5,7 +5,10 @@
 #include <algorithm>
 #include <atomic>
 #include <csignal>
+#include <filesystem>
+#include <map>
 #include <memory>
+#include <optional>
 #include <cstdio>
 #include <thread>
 
@@ -16,6 +19,7 @@
 #include "study/kept_runs.hpp"
 #include "study/runner.hpp"
 #include "study/shard.hpp"
+#include "study/store.hpp"
 #include "study/study_file.hpp"
 
 namespace crevasse {
@@ -125,6 +129,28 @@ class ConsoleObserver : public StudyObserver {
   double last_line_s_ = -1e9;
 };
 
+// True when every selected case of the database at `db` is already stored as done (or as
+// failed, without --retry-failed): a re-measurement run again then reads nothing, so its kept
+// particles need not be there (a clone holds the databases, not the particle files).
+bool nothing_left_to_run(const Study& study, const std::string& db, const std::optional<Shard>& shard,
+                         const std::vector<std::size_t>& only, bool retry_failed) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(db, ec)) return false;
+  std::map<std::string, std::string> status;
+  try {
+    Store store = Store::open_reader(db);
+    status = store.statuses();
+  } catch (const std::exception&) {
+    return false;  // the runner says what is wrong with it
+  }
+  for (const StudyCase* c : shard_cases(study, shard.value_or(Shard{0, 1}))) {
+    if (!only.empty() && !std::binary_search(only.begin(), only.end(), c->index)) continue;
+    const auto it = status.find(c->case_id);
+    if (it == status.end() || (it->second != "done" && (it->second != "failed" || retry_failed))) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 int study_command(const StudyCommandOptions& opt) {
@@ -162,7 +188,9 @@ int study_command(const StudyCommandOptions& opt) {
   // What the study reads, which none of its outputs may be, however spelt.
   std::vector<NamedPath> inputs = {{"the study file", opt.study_path}};
   std::shared_ptr<const KeptRuns> kept;
-  if (!opt.remeasure_db.empty()) {
+  const std::vector<std::size_t> only_cases =
+      opt.cases.empty() ? std::vector<std::size_t>() : parse_case_list(opt.cases, study.cases.size());
+  if (!opt.remeasure_db.empty() && !nothing_left_to_run(study, db, shard, only_cases, opt.retry_failed)) {
     kept = std::make_shared<const KeptRuns>(opt.remeasure_db, opt.particles_from);
     inputs.push_back({"--remeasure", opt.remeasure_db});
     inputs.push_back({"--particles-from", opt.particles_from});
@@ -205,7 +233,7 @@ int study_command(const StudyCommandOptions& opt) {
   ro.fail_fast = opt.fail_fast;
   ro.retry_failed = opt.retry_failed;
   ro.shard = shard;
-  if (!opt.cases.empty()) ro.only_cases = parse_case_list(opt.cases, study.cases.size());
+  ro.only_cases = only_cases;
   ro.command = opt.command_line;
   ro.views_dir = opt.views_dir;
   ro.particles_dir = particles_dir;

@@ -9,7 +9,9 @@
 # and the step's shape before the long steady row at 800 m (about 2.5 h per case on one thread):
 # 1. the replicas, and the geometry study's cases at S = 1/2, L_s = H_i measured from the steady
 #    runs' particles at 2 H_i (the cases a run would store, without the field over time:
-#    docs/model.md, "Two protocols"), then its cases that vary one of S and L_s/H_i at a time;
+#    docs/model.md, "Two protocols"), then its cases that vary one of S and L_s/H_i at a time.
+#    A measurement from kept particles whose cases are all stored reads nothing, so the steps
+#    pass on a clone, which has the databases but not the particle files;
 # 2. the initiation study's cases the steady study does not serve (H_i = 200, 600 m, and
 #    Π = 0.0375, 0.125 at 800 m); fits, figures and the field calibration;
 # 3. the steady study, which keeps each case's particles at 1.25, 2 and 3 H_i through the gate, and
@@ -41,12 +43,9 @@ $C study studies/regime_initiation_replicas.json --db $R/regime_initiation_repli
 # Geometry cases 8, 9 (S = 1/2, L_s = H_i at Π = 0.1, 0.3) are the steady study's 400 m scene.
 $C study studies/regime_initiation_geometry.json --db $R/regime_initiation_geometry.db --cases 8,9 \
   --remeasure $R/regime_steady.db --particles-from $R/regime_steady.db.particles --views $R/regime_initiation_geometry_views
-# S = 1 at L_s = H_i first (why the draped ice leaves the 1:1 ramp in slabs), then S = 0.2 at
-# L_s = H_i and L_s/H_i = 0.5, 2 at S = 1/2, at both Π.
-for cases in 14,15 2,3,6,7,10,11; do
-  $C study studies/regime_initiation_geometry.json --db $R/regime_initiation_geometry.db --cases $cases \
-    --keep-particles --views $R/regime_initiation_geometry_views
-done
+# S = 0.2, 1 at L_s = H_i and L_s/H_i = 0.5, 2 at S = 1/2, at both Π.
+$C study studies/regime_initiation_geometry.json --db $R/regime_initiation_geometry.db --cases 2,3,6,7,10,11,14,15 \
+  --keep-particles --views $R/regime_initiation_geometry_views
 # As --dry-run lists them: 20-29 the 600 m row, 30 and 34 Π = 0.0375, 0.125 at 800 m.
 $C study studies/regime_initiation.json --db $R/regime_initiation.db --cases 0-10,14,20-30,34 --keep-particles \
   --views $R/regime_initiation_views

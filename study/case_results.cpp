@@ -135,6 +135,11 @@ std::string study_field_label(Store& store) {
   return frame.empty() ? "" : frame + " frame";
 }
 
+std::string study_name_with_field(Store& store, const std::string& fallback) {
+  const std::string label = study_field_label(store);
+  return study_name(store, fallback) + (label.empty() ? std::string() : " (" + label + ")");
+}
+
 std::string study_title(Store& store) {
   const std::string label = study_field_label(store);
   return "study '" + study_name(store, "?") + "'" + (label.empty() ? "" : ", " + label) + " (" +

@@ -83,6 +83,8 @@ std::string study_name(Store& store, const std::string& fallback);
 // What a figure or fit says it shows: "initiation protocol, draped frame" (a study that names its
 // protocol), "passed frame" (one that does not), or "" (no study row).
 std::string study_field_label(Store& store);
+// The name with its field: "regime_steady (steady protocol, passed frame)", as figures label a study.
+std::string study_name_with_field(Store& store, const std::string& fallback);
 
 // "study 'quick' (results/quick.db)".
 std::string study_title(Store& store);

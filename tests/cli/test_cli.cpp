@@ -537,6 +537,13 @@ TEST(Cli, RemeasureFromKeptParticlesStoresWhatAFullRunStores) {
   const auto results = [&](const char* db) { return stored_results(dir / db); };
   EXPECT_EQ(results("again.db"), results("full.db"));
   EXPECT_NE(results("kept.db"), results("full.db")) << "the settings changed nothing: the test shows nothing";
+  // The same command where the kept particles are gone (a clone holds the databases, not the
+  // particle files): every case is done, nothing is read, nothing changes. A study with cases
+  // left to measure is still refused (below).
+  const auto stored = results("again.db");
+  const Result rerun = run_cli(dir.path(), "study other.json --db again.db --remeasure kept.db --particles-from gone --quiet");
+  EXPECT_EQ(rerun.code, 0) << rerun.err;
+  EXPECT_EQ(results("again.db"), stored);
   EXPECT_EQ(test::dump_rows(dir / "again.db", "SELECT count(*) FROM cases WHERE json_extract(run_json, "
                                                "'$.measured_from.database') = 'kept.db'")[0], "2");
   EXPECT_TRUE(std::filesystem::exists(dir / "w" / "case_001_side_view.png"));
@@ -583,6 +590,7 @@ TEST(Cli, RemeasureFromKeptParticlesStoresWhatAFullRunStores) {
   refused("study other.json --db x.db --remeasure nothing.db --particles-from v --quiet", "nothing.db");
   std::filesystem::create_directories(dir / "empty");
   refused("study other.json --db x.db --remeasure kept.db --particles-from empty --quiet", "empty");
+  refused("study other.json --db x.db --remeasure kept.db --particles-from gone --quiet", "gone");
   EXPECT_FALSE(std::filesystem::exists(dir / "x.db")) << "refused, yet the study began";
 }
 
