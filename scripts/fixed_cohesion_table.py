@@ -4,35 +4,49 @@
 If spacing is set by the ice strength (L_p proportional to c/(rho_i g)), cases with the same c and
 different H_i carry the same spacing; if it is set by bending, it follows H_i. Reads the done 2D
 cases of one or more study databases (replicas are listed one by one), groups them by c, and prints
-one markdown row per case for every c reached at two or more thicknesses:
+one markdown row per case for every c reached at two or more thicknesses (--every-c: every c):
 
     python3 scripts/fixed_cohesion_table.py results/regime_initiation.db [results/regime_initiation_replicas.db ...]
 
-Only the reference step (slope 1/2, L_s = H_i) is kept unless --all-steps is given.
+Only the reference step (slope 1/2, L_s = H_i) is kept unless --all-steps is given. The last two
+columns read the crevasse table of the window's first LEAD·H_i (--lead, default 1): in the draped
+frame that is the ice that lay on the ramp at the start (the window begins at the most downstream
+ice that came over the lip), where the row forms, apart from the floor ice further on.
 """
 import argparse
 import sqlite3
+import statistics
 import sys
 
 RHO_G = 917.0 * 9.81  # rho_i g [Pa/m], the scenes' ice density and gravity
 
 
-def cases(db_path, all_steps):
+def median(values):
+    return statistics.median(values) if values else None
+
+
+def cases(db_path, all_steps, lead):
     con = sqlite3.connect(f"file:{db_path}?mode=ro", uri=True)
     rows = con.execute(
-        """select c.case_index, c.seed, c.thickness_m, c.cohesion_ratio, c.slope, c.step_length_ratio,
-                  s.crevasse_count, s.spacing_median_m, s.spacing_q25_m, s.spacing_q75_m,
-                  s.depth_median_m, c.under_resolved
+        """select c.case_id, c.case_index, c.seed, c.thickness_m, c.cohesion_ratio, c.slope,
+                  c.step_length_ratio, s.crevasse_count, s.spacing_median_m, s.spacing_q25_m,
+                  s.spacing_q75_m, s.depth_median_m, c.under_resolved, s.window_min_x_m
            from cases c join summaries s on s.case_id = c.case_id
            where c.status = 'done' and c.dim = 2""").fetchall()
-    con.close()
     out = []
-    for (index, seed, h, pi, slope, ls_ratio, count, l_med, l_25, l_75, d_med, under) in rows:
+    for (case_id, index, seed, h, pi, slope, ls_ratio, count, l_med, l_25, l_75, d_med, under,
+         window_min) in rows:
         if not all_steps and (abs((slope or 0.5) - 0.5) > 1e-9 or abs(ls_ratio - 1.0) > 1e-9):
             continue
+        lead_cracks = con.execute(
+            "select x_m, depth_m from crevasses where case_id = ? and x_m <= ? order by x_m",
+            (case_id, window_min + lead * h)).fetchall()
+        pairs = [b[0] - a[0] for a, b in zip(lead_cracks, lead_cracks[1:])]
         out.append(dict(db=db_path, index=index, seed=seed, h=h, pi=pi, c=pi * RHO_G * h,
                         count=count, l_med=l_med, l_25=l_25, l_75=l_75, d_med=d_med,
-                        under=bool(under)))
+                        under=bool(under), lead_count=len(lead_cracks), lead_l=median(pairs),
+                        lead_d=median([d for _, d in lead_cracks])))
+    con.close()
     return out
 
 
@@ -44,12 +58,16 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("databases", nargs="+")
     parser.add_argument("--all-steps", action="store_true", help="keep every step shape")
+    parser.add_argument("--lead", type=float, default=1.0,
+                        help="length of the window's leading part, in H_i (default 1)")
+    parser.add_argument("--every-c", action="store_true",
+                        help="also list the values of c reached at one thickness only")
     args = parser.parse_args()
 
     every = []
     for db in args.databases:
         try:
-            every += cases(db, args.all_steps)
+            every += cases(db, args.all_steps, args.lead)
         except sqlite3.Error as error:
             sys.exit(f"error: {db}: {error}")
 
@@ -58,11 +76,11 @@ def main():
         groups.setdefault(round(case["c"] / 1000.0), []).append(case)
 
     print("| c [kPa] | c/(ρ_i g) [m] | H_i [m] | Π | case (seed) | count | median L_p [m] (quartiles) "
-          "| median D_p [m] | D_p/(c/(ρ_i g)) | L_p/D_p |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+          "| median D_p [m] | D_p/(c/(ρ_i g)) | L_p/D_p | window's first LEAD·H_i: count, median pair spacing, median depth [m] |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     for c_kpa in sorted(groups):
         group = sorted(groups[c_kpa], key=lambda k: (k["h"], k["seed"]))
-        if len({k["h"] for k in group}) < 2:
+        if len({k["h"] for k in group}) < 2 and not args.every_c:
             continue
         length = c_kpa * 1000.0 / RHO_G
         for k in group:
@@ -72,7 +90,8 @@ def main():
                 spacing += f" ({fmt(k['l_25'])}–{fmt(k['l_75'])})"
             print(f"| {c_kpa} | {length:.0f} | {k['h']:.0f} | {k['pi']:g}{' (under-resolved)' if k['under'] else ''} "
                   f"| {k['index']} ({k['seed']}) | {k['count']} | {spacing} | {fmt(k['d_med'])} "
-                  f"| {fmt(None if k['d_med'] is None else k['d_med'] / length, 1)} | {fmt(ratio, 2)} |")
+                  f"| {fmt(None if k['d_med'] is None else k['d_med'] / length, 1)} | {fmt(ratio, 2)} "
+                  f"| {k['lead_count']}, {fmt(k['lead_l'])}, {fmt(k['lead_d'])} |")
 
 
 if __name__ == "__main__":
