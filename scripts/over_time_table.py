@@ -55,7 +55,7 @@ def main():
     ap.add_argument("db", help="study database, or a running case's CASE.ckpt.over_time.json")
     ap.add_argument("--thickness", type=float, default=0.0, help="H_i [m], with an over_time.json file")
     ap.add_argument("--pi", type=float, default=float("nan"), help="Pi, with an over_time.json file (shown only)")
-    ap.add_argument("--cases", default="", help="case indices, comma-separated (default all)")
+    ap.add_argument("--cases", default="", help="case indices, e.g. 3,5,8-11 (default all)")
     ap.add_argument("--every", type=float, default=0.0, help="print one row per this many H_i pushed")
     ap.add_argument("--tolerance-cracks", type=int, default=1, help="-1: leave the count out (passed frame)")
     ap.add_argument("--tolerance-spacing", type=float, default=0.0125)
@@ -83,8 +83,20 @@ def read_db(path):
     return rows
 
 
+def case_list(text):
+    """Case indices as the study command takes them: "3,5,8-11"."""
+    wanted = set()
+    for part in (p.strip() for p in text.split(",")):
+        if "-" in part:
+            first, last = (int(x) for x in part.split("-", 1))
+            wanted.update(range(first, last + 1))
+        elif part:
+            wanted.add(int(part))
+    return wanted
+
+
 def show(rows, a):
-    wanted = {int(x) for x in a.cases.split(",") if x.strip()}
+    wanted = case_list(a.cases)
     tol_len = max(a.tolerance_spacing, a.spread)
     for idx, h, pi, seed, rj in rows:
         if wanted and idx not in wanted:
