@@ -129,26 +129,20 @@ class ConsoleObserver : public StudyObserver {
   double last_line_s_ = -1e9;
 };
 
-// True when every selected case of the database at `db` is already stored as done (or as
-// failed, without --retry-failed): a re-measurement run again then reads nothing, so its kept
-// particles need not be there (a clone holds the databases, not the particle files).
+// True when the database at `db` holds every selected case as done (or failed, without
+// --retry-failed): the runner would start none, so a re-measurement reads no kept particles and
+// they need not be there (a clone holds the databases, not the particle files).
 bool nothing_left_to_run(const Study& study, const std::string& db, const std::optional<Shard>& shard,
                          const std::vector<std::size_t>& only, bool retry_failed) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(db, ec)) return false;
   std::map<std::string, std::string> status;
   try {
-    Store store = Store::open_reader(db);
-    status = store.statuses();
+    status = Store::open_reader(db).statuses();
   } catch (const std::exception&) {
     return false;  // the runner says what is wrong with it
   }
-  for (const StudyCase* c : shard_cases(study, shard.value_or(Shard{0, 1}))) {
-    if (!only.empty() && !std::binary_search(only.begin(), only.end(), c->index)) continue;
-    const auto it = status.find(c->case_id);
-    if (it == status.end() || (it->second != "done" && (it->second != "failed" || retry_failed))) return false;
-  }
-  return true;
+  return cases_to_run(shard_cases(study, shard.value_or(Shard{0, 1})), status, only, retry_failed).empty();
 }
 
 }  // namespace

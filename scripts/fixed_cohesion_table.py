@@ -18,9 +18,6 @@ import sqlite3
 import statistics
 import sys
 
-RHO_G = 917.0 * 9.81  # rho_i g [Pa/m], the scenes' ice density and gravity
-
-
 def median(values):
     return statistics.median(values) if values else None
 
@@ -30,19 +27,21 @@ def cases(db_path, all_steps, lead):
     rows = con.execute(
         """select c.case_id, c.case_index, c.seed, c.thickness_m, c.cohesion_ratio, c.slope,
                   c.step_length_ratio, s.crevasse_count, s.spacing_median_m, s.spacing_q25_m,
-                  s.spacing_q75_m, s.depth_median_m, c.under_resolved, s.window_min_x_m
+                  s.spacing_q75_m, s.depth_median_m, c.under_resolved, s.window_min_x_m,
+                  c.tensile_strength_pa,
+                  json_extract(c.scene_json, '$.ice.density') * json_extract(c.scene_json, '$.gravity.g')
            from cases c join summaries s on s.case_id = c.case_id
            where c.status = 'done' and c.dim = 2""").fetchall()
     out = []
     for (case_id, index, seed, h, pi, slope, ls_ratio, count, l_med, l_25, l_75, d_med, under,
-         window_min) in rows:
+         window_min, c, rho_g) in rows:
         if not all_steps and (abs((slope or 0.5) - 0.5) > 1e-9 or abs(ls_ratio - 1.0) > 1e-9):
             continue
         lead_cracks = con.execute(
             "select x_m, depth_m from crevasses where case_id = ? and x_m <= ? order by x_m",
             (case_id, window_min + lead * h)).fetchall()
         pairs = [b[0] - a[0] for a, b in zip(lead_cracks, lead_cracks[1:])]
-        out.append(dict(db=db_path, index=index, seed=seed, h=h, pi=pi, c=pi * RHO_G * h,
+        out.append(dict(db=db_path, index=index, seed=seed, h=h, pi=pi, c=c, rho_g=rho_g,
                         count=count, l_med=l_med, l_25=l_25, l_75=l_75, d_med=d_med,
                         under=bool(under), lead_count=len(lead_cracks), lead_l=median(pairs),
                         lead_d=median([d for _, d in lead_cracks])))
@@ -82,8 +81,8 @@ def main():
         group = sorted(groups[c_kpa], key=lambda k: (k["h"], k["seed"]))
         if len({k["h"] for k in group}) < 2 and not args.every_c:
             continue
-        length = c_kpa * 1000.0 / RHO_G
         for k in group:
+            length = k["c"] / k["rho_g"]  # c/(rho_i g) with the case's own density and gravity
             ratio = None if (k["l_med"] is None or not k["d_med"]) else k["l_med"] / k["d_med"]
             spacing = fmt(k["l_med"])
             if k["l_25"] is not None:

@@ -22,7 +22,7 @@ cd "$(dirname "$0")/.."
 cmake --build build -j "$(nproc)" --target crevasse
 C=./build/cli/crevasse
 R=results
-# The long cases run one at a time on both cores (the same results bit for bit as one thread each,
+# The cases still to run go one at a time on both cores (the same results bit for bit as one thread each,
 # docs/performance.md, "Bit identity"): a case finishes in half the wall time, so an interruption loses at most
 # one case's progress since its last checkpoint, and a sitting of a few hours finishes whole cases.
 ONE_CASE_AT_A_TIME="--jobs 1 --threads-per-case 2"
@@ -70,6 +70,6 @@ fit_and_plot 1 2 4 12
 
 # The rest of the geometry study, S and L_s/H_i together; then its fits and figures.
 $C study studies/regime_initiation_geometry.json --db $R/regime_initiation_geometry.db --keep-particles \
-  --views $R/regime_initiation_geometry_views
+  --views $R/regime_initiation_geometry_views $ONE_CASE_AT_A_TIME
 $C fit $R/regime_initiation_geometry.db
 $C plot $R/regime_initiation_geometry.db --out $R/regime_initiation_geometry_figures --cdf-normalise bending

@@ -241,10 +241,6 @@ class StudyRun {
       if (std::none_of(scope.begin(), scope.end(), [i](const StudyCase* c) { return c->index == i; }))
         throw InputError("--cases: case " + std::to_string(i) + " is not in shard " +
                          (opt_.shard ? opt_.shard->text() : std::string("0/1")));
-    const auto selected = [this](const StudyCase* c) {
-      return opt_.only_cases.empty() ||
-             std::binary_search(opt_.only_cases.begin(), opt_.only_cases.end(), c->index);
-    };
     const auto status = store_.statuses();
     for (const StudyCase* c : scope) {
       const std::string& st = status.at(c->case_id);
@@ -252,9 +248,8 @@ class StudyRun {
         ++report_.already_done;
       else if (st == "failed" && !opt_.retry_failed)
         ++report_.already_failed;
-      else if (selected(c))
-        todo_.push_back(c);
     }
+    todo_ = cases_to_run(scope, status, opt_.only_cases, opt_.retry_failed);
     if (!opt_.case_function) check_memory();  // before the session: the cases stay pending
     store_.begin_session(session);
     report_.session_id = session.session_id;
@@ -469,6 +464,20 @@ class StudyRun {
 };
 
 }  // namespace
+
+std::vector<const StudyCase*> cases_to_run(const std::vector<const StudyCase*>& scope,
+                                           const std::map<std::string, std::string>& status,
+                                           const std::vector<std::size_t>& only_cases, bool retry_failed) {
+  std::vector<const StudyCase*> out;
+  for (const StudyCase* c : scope) {
+    if (!only_cases.empty() && !std::binary_search(only_cases.begin(), only_cases.end(), c->index)) continue;
+    const auto it = status.find(c->case_id);
+    const bool stored_done = it != status.end() && it->second == "done";
+    const bool stored_failed = it != status.end() && it->second == "failed";
+    if (!stored_done && !(stored_failed && !retry_failed)) out.push_back(c);
+  }
+  return out;
+}
 
 RunnerReport run_study(const Study& study, const RunnerOptions& opt) {
   // Before the database is opened: a file where the checkpoint folder belongs would otherwise

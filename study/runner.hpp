@@ -8,8 +8,10 @@
 #include <chrono>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "analysis/crevasse_measure.hpp"
 #include "study/case_context.hpp"
@@ -78,6 +80,13 @@ struct RunnerOptions {
   // running ones save a checkpoint and stay pending for the next session (report.interrupted).
   std::atomic<bool>* interrupt = nullptr;
 };
+
+// The cases of `scope` a run starts, given the stored `status` of each case id: those selected by
+// `only_cases` (all when empty; sorted) that are not stored as done, nor as failed unless
+// `retry_failed`. A case with no status yet, or left "running" by a stopped session, is to run.
+std::vector<const StudyCase*> cases_to_run(const std::vector<const StudyCase*>& scope,
+                                           const std::map<std::string, std::string>& status,
+                                           const std::vector<std::size_t>& only_cases, bool retry_failed);
 
 // Throws InputError before anything runs when the database is unusable or holds another study,
 // or when DB.checkpoints (needed when resources.checkpoint_interval_s > 0) is not a directory.

@@ -544,6 +544,10 @@ TEST(Cli, RemeasureFromKeptParticlesStoresWhatAFullRunStores) {
   const Result rerun = run_cli(dir.path(), "study other.json --db again.db --remeasure kept.db --particles-from gone --quiet");
   EXPECT_EQ(rerun.code, 0) << rerun.err;
   EXPECT_EQ(results("again.db"), stored);
+  // With one case measured, the same holds for that case alone, and the other still needs them.
+  ASSERT_EQ(run_cli(dir.path(), "study other.json --db part.db --cases 0 --remeasure kept.db --particles-from v --quiet").code, 0);
+  EXPECT_EQ(run_cli(dir.path(), "study other.json --db part.db --cases 0 --remeasure kept.db --particles-from gone --quiet").code, 0);
+  EXPECT_EQ(run_cli(dir.path(), "study other.json --db part.db --remeasure kept.db --particles-from gone --quiet").code, 2);
   EXPECT_EQ(test::dump_rows(dir / "again.db", "SELECT count(*) FROM cases WHERE json_extract(run_json, "
                                                "'$.measured_from.database') = 'kept.db'")[0], "2");
   EXPECT_TRUE(std::filesystem::exists(dir / "w" / "case_001_side_view.png"));

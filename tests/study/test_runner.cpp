@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <map>
 #include <mutex>
 #include <set>
 #include <thread>
@@ -19,6 +20,30 @@ namespace crevasse {
 namespace {
 
 using namespace std::chrono_literals;
+
+// The runner and the study command's re-measurement check both ask this which cases a run starts.
+TEST(CasesToRun, SkipsDoneAndFailedKeepsPendingRunningAndUnstoredWithinTheSelection) {
+  std::vector<StudyCase> cases(5);
+  const char* stored[] = {"done", "failed", "pending", "running", nullptr};
+  std::map<std::string, std::string> status;
+  std::vector<const StudyCase*> scope;
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    cases[i].index = i;
+    cases[i].case_id = "id" + std::to_string(i);
+    if (stored[i]) status[cases[i].case_id] = stored[i];
+    scope.push_back(&cases[i]);
+  }
+  const auto indices = [](const std::vector<const StudyCase*>& v) {
+    std::vector<std::size_t> out;
+    for (const StudyCase* c : v) out.push_back(c->index);
+    return out;
+  };
+  EXPECT_EQ(indices(cases_to_run(scope, status, {}, false)), (std::vector<std::size_t>{2, 3, 4}));
+  EXPECT_EQ(indices(cases_to_run(scope, status, {}, true)), (std::vector<std::size_t>{1, 2, 3, 4}));
+  EXPECT_EQ(indices(cases_to_run(scope, status, {0, 1, 3}, false)), (std::vector<std::size_t>{3}));
+  EXPECT_TRUE(cases_to_run(scope, status, {0, 1}, false).empty());
+  EXPECT_EQ(indices(cases_to_run(scope, status, {0, 1}, true)), (std::vector<std::size_t>{1}));
+}
 
 RunnerOptions fake_options(const std::filesystem::path& db, CaseFunction f, int jobs = 2) {
   RunnerOptions o;
