@@ -50,7 +50,11 @@ $C study studies/regime_initiation_geometry.json --db $R/regime_initiation_geome
 # S = 0.2, 1 at L_s = H_i and L_s/H_i = 0.5, 2 at S = 1/2, at both Π.
 $C study studies/regime_initiation_geometry.json --db $R/regime_initiation_geometry.db --cases 2,3,6,7,10,11,14,15 \
   --keep-particles --views $R/regime_initiation_geometry_views
-# As --dry-run lists them: 20-29 the 600 m row, 30 and 34 Π = 0.0375, 0.125 at 800 m.
+# As --dry-run lists them: 20-29 the 600 m row, 30 and 34 Π = 0.0375, 0.125 at 800 m. Case 30 goes first:
+# at 800 m, Π = 0.0375 is c = 0.27 MPa, the cohesion whose row the 400 and 600 m cases share (the
+# strength regime's test at a fixed c, results/README.md).
+$C study studies/regime_initiation.json --db $R/regime_initiation.db --cases 30 --keep-particles \
+  --views $R/regime_initiation_views $ONE_CASE_AT_A_TIME
 $C study studies/regime_initiation.json --db $R/regime_initiation.db --cases 0-10,14,20-30,34 --keep-particles \
   --views $R/regime_initiation_views $ONE_CASE_AT_A_TIME
 fit_and_plot 1 2 4
