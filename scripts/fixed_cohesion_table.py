@@ -8,10 +8,11 @@ one markdown row per case for every c reached at two or more thicknesses (--ever
 
     python3 scripts/fixed_cohesion_table.py results/regime_initiation.db [results/regime_initiation_replicas.db ...]
 
-Only the reference step (slope 1/2, L_s = H_i) is kept unless --all-steps is given. The last two
-columns read the crevasse table of the window's first LEAD·H_i (--lead, default 1): in the draped
-frame that is the ice that lay on the ramp at the start (the window begins at the most downstream
-ice that came over the lip), where the row forms, apart from the floor ice further on.
+Only the reference step (slope 1/2, L_s = H_i) is kept unless --all-steps is given. The last
+column reads the crevasse table of the window's first LEAD·L_s (--lead, default 1; L_s the step's
+horizontal length): in the draped frame that is the ice that lay on the ramp at the start (the
+window begins at the most downstream ice that came over the lip), where the row forms, apart from
+the floor ice further on. `ramp_ice_extent.py` measures where that ice ends in kept particles.
 """
 import argparse
 import sqlite3
@@ -29,17 +30,18 @@ def cases(db_path, all_steps, lead):
                   c.step_length_ratio, s.crevasse_count, s.spacing_median_m, s.spacing_q25_m,
                   s.spacing_q75_m, s.depth_median_m, c.under_resolved, s.window_min_x_m,
                   c.tensile_strength_pa,
-                  json_extract(c.scene_json, '$.ice.density') * json_extract(c.scene_json, '$.gravity.g')
+                  json_extract(c.scene_json, '$.ice.density') * json_extract(c.scene_json, '$.gravity.g'),
+                  json_extract(c.scene_json, '$.bed.step_length')
            from cases c join summaries s on s.case_id = c.case_id
            where c.status = 'done' and c.dim = 2""").fetchall()
     out = []
     for (case_id, index, seed, h, pi, slope, ls_ratio, count, l_med, l_25, l_75, d_med, under,
-         window_min, c, rho_g) in rows:
+         window_min, c, rho_g, step_length) in rows:
         if not all_steps and (abs((slope or 0.5) - 0.5) > 1e-9 or abs(ls_ratio - 1.0) > 1e-9):
             continue
         lead_cracks = con.execute(
             "select x_m, depth_m from crevasses where case_id = ? and x_m <= ? order by x_m",
-            (case_id, window_min + lead * h)).fetchall()
+            (case_id, window_min + lead * step_length)).fetchall()
         pairs = [b[0] - a[0] for a, b in zip(lead_cracks, lead_cracks[1:])]
         out.append(dict(db=db_path, index=index, seed=seed, h=h, pi=pi, c=c, rho_g=rho_g,
                         count=count, l_med=l_med, l_25=l_25, l_75=l_75, d_med=d_med,
@@ -58,7 +60,7 @@ def main():
     parser.add_argument("databases", nargs="+")
     parser.add_argument("--all-steps", action="store_true", help="keep every step shape")
     parser.add_argument("--lead", type=float, default=1.0,
-                        help="length of the window's leading part, in H_i (default 1)")
+                        help="length of the window's leading part, in L_s (default 1)")
     parser.add_argument("--every-c", action="store_true",
                         help="also list the values of c reached at one thickness only")
     args = parser.parse_args()
@@ -75,7 +77,7 @@ def main():
         groups.setdefault(round(case["c"] / 1000.0), []).append(case)
 
     print("| c [kPa] | c/(ρ_i g) [m] | H_i [m] | Π | case (seed) | count | median L_p [m] (quartiles) "
-          "| median D_p [m] | D_p/(c/(ρ_i g)) | L_p/D_p | window's first LEAD·H_i: count, median pair spacing, median depth [m] |")
+          "| median D_p [m] | D_p/(c/(ρ_i g)) | L_p/D_p | window's first LEAD·L_s: count, median pair spacing, median depth [m] |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     for c_kpa in sorted(groups):
         group = sorted(groups[c_kpa], key=lambda k: (k["h"], k["seed"]))
