@@ -18,6 +18,14 @@
 
 namespace crevasse::analysis {
 
+QuartileSummary quartiles(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  // GSL interpolates linearly between order statistics (Hyndman–Fan type 7).
+  return {gsl_stats_quantile_from_sorted_data(values.data(), 1, values.size(), 0.25),
+          gsl_stats_quantile_from_sorted_data(values.data(), 1, values.size(), 0.50),
+          gsl_stats_quantile_from_sorted_data(values.data(), 1, values.size(), 0.75)};
+}
+
 namespace {
 
 void require(bool ok, const std::string& message) {
@@ -45,14 +53,6 @@ void check_arrays(const ParticleSnapshot& s) {
     require(s.y.size() == n, "3D snapshot y has " + std::to_string(s.y.size()) +
                                  " entries but x has " + std::to_string(n));
   }
-}
-
-QuartileSummary quartiles(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  // GSL interpolates linearly between order statistics (Hyndman–Fan type 7).
-  return {gsl_stats_quantile_from_sorted_data(values.data(), 1, values.size(), 0.25),
-          gsl_stats_quantile_from_sorted_data(values.data(), 1, values.size(), 0.50),
-          gsl_stats_quantile_from_sorted_data(values.data(), 1, values.size(), 0.75)};
 }
 
 QuartileSummary scaled(QuartileSummary q, double factor) {

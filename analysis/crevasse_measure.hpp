@@ -144,6 +144,9 @@ struct QuartileSummary {
   double median = 0.0;
   double q75 = 0.0;
 };
+// Quartiles of a non-empty sample, linear between order statistics (Hyndman–Fan type 7, GSL's):
+// every stored distribution uses them.
+QuartileSummary quartiles(std::vector<double> values);
 
 struct MeasureFlags {
   bool empty_snapshot = false;  // no particles (in the 3D band) at all

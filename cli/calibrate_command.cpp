@@ -98,18 +98,23 @@ struct StudyLaws {
   double thickness_min = 0.0, thickness_max = 0.0;  // H_i the study ran
 };
 
-StudyLaws load_laws(const std::string& db_path) {
+StudyLaws load_laws(const std::string& db_path, bool ramp_ice) {
+  const CaseReading reading = ramp_ice ? CaseReading::ramp_ice : CaseReading::window;
   Store store = Store::open_reader(db_path);
-  const std::vector<CaseRecord> cases = read_case_records(store);
+  const std::vector<CaseRecord> cases = read_case_records(store, reading);
   StudyLaws laws;
-  laws.title = study_title(store);
+  laws.title = study_title(store) + reading_label(reading);
   const FitGroup& pi = find_fit_group("cohesion_ratio", "group");
-  std::vector<FitRecord> spacing = read_fit_records(store, "spacing_over_h", pi.name);
-  std::vector<FitRecord> depth = read_fit_records(store, "depth_over_h", pi.name);
+  std::vector<FitRecord> spacing =
+      read_fit_records(store, fit_quantity_key(Quantity::spacing, reading), pi.name);
+  std::vector<FitRecord> depth =
+      read_fit_records(store, fit_quantity_key(Quantity::depth, reading), pi.name);
   if (!spacing.empty()) {
-    laws.source = "laws from the fits table (crevasse fit, " + spacing.front().created_at + ")";
+    laws.source = std::string("laws from the fits table (crevasse fit") +
+                  (ramp_ice ? " --ramp-ice" : "") + ", " + spacing.front().created_at + ")";
   } else {
-    laws.source = "no fits table yet: laws fitted now with the defaults (crevasse fit stores them)";
+    laws.source = std::string("no fits table yet: laws fitted now with the defaults (crevasse fit") +
+                  (ramp_ice ? " --ramp-ice" : "") + " stores them)";
     spacing = fit_records(fit_study(cases, Quantity::spacing, pi), "");
     depth = fit_records(fit_study(cases, Quantity::depth, pi), "");
   }
@@ -203,7 +208,7 @@ int calibrate_observations(const CalibrateCommandOptions& opt) {
   const FieldObservationFile file = load_field_observations(opt.observations_path);
   const std::vector<FieldObservation>& sites = file.sites;
   const std::vector<LiteratureStrength>& literature = file.literature;
-  const StudyLaws laws = load_laws(opt.db_path);
+  const StudyLaws laws = load_laws(opt.db_path, opt.ramp_ice);
   const analysis::CalibrationOptions options = calibration_options(laws, opt.level);
   print_header(laws, opt.level);
   std::printf("observations: %s (%zu sites)\n\n", opt.observations_path.c_str(), sites.size());
@@ -332,7 +337,7 @@ int calibrate_command(const CalibrateCommandOptions& opt) {
     obs.spacing_q75_m = q75;
   }
 
-  const StudyLaws laws = load_laws(opt.db_path);
+  const StudyLaws laws = load_laws(opt.db_path, opt.ramp_ice);
   const analysis::CalibrationOptions options = calibration_options(laws, opt.level);
 
   const std::vector<Answer> answers = invert_in_every_regime(laws, obs, options, "--spacing: ");
@@ -388,7 +393,7 @@ int predict_command(const PredictCommandOptions& opt) {
   check_confidence_level(opt.level);
   positive(opt.tensile_strength_pa, "--cohesion");
   positive(opt.thickness_m, "--thickness");
-  const StudyLaws laws = load_laws(opt.db_path);
+  const StudyLaws laws = load_laws(opt.db_path, opt.ramp_ice);
   const double pi = analysis::cohesion_ratio(opt.tensile_strength_pa, opt.thickness_m, laws.ice);
   const auto holds = [&](const QuantityRegime& r) { return r.pi_min <= pi && pi <= r.pi_max; };
   const auto& spacing = laws.spacing.regimes;

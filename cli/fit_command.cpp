@@ -59,7 +59,7 @@ void print_table(const std::vector<FitRecord>& records, const FitGroup& group, d
               "n", "exponent b", "prefactor a [CI]", "breakpoint [CI]", "R^2",
               "single vs broken line");
   for (const FitRecord& r : records) {
-    const char* symbol = r.quantity == "spacing_over_h" ? "L_p/H_i" : "D_p/H_i";
+    const char* symbol = r.quantity.find("spacing") != std::string::npos ? "L_p/H_i" : "D_p/H_i";
     if (!r.ok()) {
       std::printf("  %-8s %-6s %-6s %4lld  NOT ENOUGH DATA: %s\n", symbol, r.model.c_str(),
                   r.regime.c_str(), static_cast<long long>(r.n), r.note.c_str());
@@ -104,12 +104,13 @@ int fit_command(const FitCommandOptions& opt) {
   if (!opt.fixed_depth_exponents.empty())
     parse_fixed_exponents(opt.fixed_depth_exponents, "--fixed-depth-exponents", depth_options);
 
+  const CaseReading reading = opt.ramp_ice ? CaseReading::ramp_ice : CaseReading::window;
   std::vector<CaseRecord> cases;
   std::string title;
   {
     Store reader = Store::open_reader(opt.db_path);
-    cases = read_case_records(reader);
-    title = study_title(reader);
+    cases = read_case_records(reader, reading);
+    title = study_title(reader) + reading_label(reading);
   }
   std::vector<const FitGroup*> groups;
   for (const std::string& name :
@@ -136,7 +137,8 @@ int fit_command(const FitCommandOptions& opt) {
     for (Quantity q : kQuantities) {
       const StudyFit fit =
           fit_study(cases, q, *group, q == Quantity::spacing ? spacing_options : depth_options);
-      const auto rows = fit_records(fit, now);
+      auto rows = fit_records(fit, now);
+      for (FitRecord& r : rows) r.quantity = fit_quantity_key(q, reading);
       records.insert(records.end(), rows.begin(), rows.end());
       notes.push_back(std::string(quantity_symbol(q)) + ": " + fit.accounting() +
                       (fit.options.fixed_b1 || fit.options.fixed_b2

@@ -16,6 +16,7 @@ struct FitCommandOptions {
   bool exclude_fragmented = false;
   bool include_under_resolved = false;  // fit cases with c/(ρ_i g) < 3 dx too
   bool no_store = false;  // print only
+  bool ramp_ice = false;  // the draped window's first L_s only (docs/measurement.md, "The ramp's ice")
 };
 
 int fit_command(const FitCommandOptions& opt);

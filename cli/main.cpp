@@ -138,6 +138,7 @@ int run_command_line(int argc, char** argv) {
   fit->add_flag("--exclude-fragmented", fit_opt.exclude_fragmented, "Leave out cases flagged fragmented");
   fit->add_flag("--include-under-resolved", fit_opt.include_under_resolved, "Fit cases flagged under_resolved (c/(rho_i g) < 3 dx) too; by default they are left out");
   fit->add_flag("--no-store", fit_opt.no_store, "Print the table only; do not write the fits table");
+  fit->add_flag("--ramp-ice", fit_opt.ramp_ice, "Read only the draped window's first L_s, the ice that lay over the ramp at the start (docs/measurement.md, \"The ramp's ice\"); stored beside the window's fits as ramp_ice_*");
 
   crevasse::PlotCommandOptions plot_opt;
   auto* plot = app.add_subcommand("plot", "Regime diagrams and spacing CDFs of a study as PNG and SVG");
@@ -152,6 +153,7 @@ int run_command_line(int argc, char** argv) {
   plot->add_option("--cdf-normalise", plot_opt.cdf_normalise, "Spacing CDFs normalised by: median (of each case), thickness (H_i), bending (sqrt(c H_i/(rho_i g))), strength (c/(rho_i g)), none; the depth CDFs of the same cases are over H_i");
   plot->add_option("--add-cases", plot_opt.add_cases, "Other study databases whose cases are drawn too, not fitted (e.g. 3D cases on the 2D diagram)")->delimiter(',');
   plot->add_flag("--include-under-resolved", plot_opt.include_under_resolved, "Fit and draw under_resolved cases (c/(rho_i g) < 3 dx) like the others; by default they are drawn hollow and not fitted");
+  plot->add_flag("--ramp-ice", plot_opt.ramp_ice, "Read only the draped window's first L_s, the ice that lay over the ramp at the start (docs/measurement.md, \"The ramp's ice\"); figures named ramp_ice_*");
   plot->add_flag("--exclude-fragmented", plot_opt.exclude_fragmented, "Leave fragmented cases out of the drawn fit, marked on the bottom edge (default: as the fits table was made)");
 
   crevasse::CalibrateCommandOptions calibrate_opt;
@@ -164,6 +166,7 @@ int run_command_line(int argc, char** argv) {
   calibrate->add_option("--level", calibrate_opt.level, "Confidence level (default 0.95)");
   calibrate->add_option("--observations", calibrate_opt.observations_path, "Field observations file (studies/field/observations.json): every site as a table, instead of --spacing");
   calibrate->add_option("--csv", calibrate_opt.csv_path, "With --observations: write the table as CSV too");
+  calibrate->add_flag("--ramp-ice", calibrate_opt.ramp_ice, "Use the laws fitted to the ramp's ice (crevasse fit --ramp-ice)");
 
   crevasse::PredictCommandOptions predict_opt;
   auto* predict = app.add_subcommand("predict", "Predict crevasse spacing and depth for a tensile strength and thickness");
@@ -171,6 +174,7 @@ int run_command_line(int argc, char** argv) {
   predict->add_option("--cohesion", predict_opt.tensile_strength_pa, "Tensile strength c [Pa]")->required();
   predict->add_option("--thickness", predict_opt.thickness_m, "Ice thickness H_i [m]")->required();
   predict->add_option("--level", predict_opt.level, "Confidence level (default 0.95)");
+  predict->add_flag("--ramp-ice", predict_opt.ramp_ice, "Use the laws fitted to the ramp's ice (crevasse fit --ramp-ice)");
 
   crevasse::AccuracyCommandOptions accuracy_opt;
   auto* accuracy = app.add_subcommand("accuracy", "Accuracy against cost of a study over the numerics (studies/accuracy_flowing.json): table and figure");

@@ -26,14 +26,14 @@ std::string group_value_label(const FitGroup& g, const std::optional<double>& v)
 }
 
 // The fixed exponents given on the command line, else those the fits table was made with.
-StudyFitOptions fit_options(Store& store, Quantity q, const FitGroup& group,
+StudyFitOptions fit_options(Store& store, const std::string& quantity, const FitGroup& group,
                             const std::string& given, const std::string& option) {
   StudyFitOptions options;
   if (!given.empty()) {
     parse_fixed_exponents(given, option, options);
     return options;
   }
-  for (const FitRecord& r : read_fit_records(store, quantity_key(q), group.name)) {
+  for (const FitRecord& r : read_fit_records(store, quantity, group.name)) {
     if (!r.fixed_exponents.empty()) {
       parse_fixed_exponents(r.fixed_exponents, "fits table", options);
       break;
@@ -119,8 +119,11 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
                      "' is not one of median, thickness, bending, strength, none");
 
   Store store = Store::open_reader(opt.db_path);
-  const std::vector<CaseRecord> cases = read_case_records(store);
-  const std::string own_name = study_name_with_field(store, "study");
+  const CaseReading reading = opt.ramp_ice ? CaseReading::ramp_ice : CaseReading::window;
+  const std::vector<CaseRecord> cases = read_case_records(store, reading);
+  const std::string own_name = study_name_with_field(store, "study") + reading_label(reading);
+  // Both readings' figures can share a folder.
+  const std::string file_prefix = reading == CaseReading::ramp_ice ? "ramp_ice_" : "";
   std::vector<const CaseRecord*> cdf_cases;
   for (std::int64_t index : opt.cdf_cases) {
     const auto it = std::find_if(cases.begin(), cases.end(),
@@ -142,10 +145,10 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
     Store other = Store::open_reader(path);
     added_names.push_back(study_name(other, path));
     added_legend.push_back(study_name_with_field(other, path));
-    added.push_back(read_case_records(other));
+    added.push_back(read_case_records(other, reading));
   }
   // The fits table is read while drawing; an inconsistent row is refused here, before the folder.
-  for (Quantity q : kQuantities) read_fit_records(store, quantity_key(q), group.name);
+  for (Quantity q : kQuantities) read_fit_records(store, fit_quantity_key(q, reading), group.name);
   // Only once every input has been read: a refusal leaves no folder behind.
   create_output_directory("--out", opt.out_dir);
   std::vector<std::pair<const CaseRecord*, std::string>> drawn_cases;
@@ -158,14 +161,15 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
   for (Quantity q : kQuantities) {
     const std::string option =
         q == Quantity::spacing ? "--fixed-exponents" : "--fixed-depth-exponents";
+    const std::string key = fit_quantity_key(q, reading);
     StudyFitOptions fit_opts =
-        fit_options(store, q, group,
+        fit_options(store, key, group,
                     q == Quantity::spacing ? opt.fixed_exponents : opt.fixed_depth_exponents,
                     option);
     // Leave fragmented cases out of the fit when asked, or when the stored fits did.
     fit_opts.exclude_fragmented = opt.exclude_fragmented;
     fit_opts.include_under_resolved = opt.include_under_resolved;
-    for (const FitRecord& r : read_fit_records(store, quantity_key(q), group.name))
+    for (const FitRecord& r : read_fit_records(store, key, group.name))
       if (r.accounting.find(kFragmentedExcluded) != std::string::npos)
         fit_opts.exclude_fragmented = true;
     const StudyFit fit = fit_study(cases, q, group, fit_opts);
@@ -225,8 +229,8 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
     options.x_symbol = group.symbol;
     if (std::string(group.name) == "cohesion_ratio") add_references(options, q, drawn_cases, points);
     const analysis::Figure figure = analysis::regime_diagram(points, drawn, options);
-    const std::string stem =
-        std::string(q == Quantity::spacing ? "spacing" : "depth") + "_vs_" + group.name;
+    const std::string stem = file_prefix + (q == Quantity::spacing ? "spacing" : "depth") +
+                             "_vs_" + group.name;
     const auto files = write_png_and_svg(figure, fs::path(opt.out_dir) / stem);
     written.insert(written.end(), files.begin(), files.end());
     std::string missing_text;
@@ -275,7 +279,7 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
                 : opt.cdf_normalise == "strength"  ? "L_p / (c/(ρ_i g))"
                                                    : "L_p [m]";
   const auto files = write_png_and_svg(analysis::empirical_cdf_figure(samples, cdf),
-                                       fs::path(opt.out_dir) / "spacing_cdf");
+                                       fs::path(opt.out_dir) / (file_prefix + "spacing_cdf"));
   written.insert(written.end(), files.begin(), files.end());
   std::printf("%s: spacing CDFs of case(s)", files.front().c_str());
   for (const CaseRecord* c : cdf_cases) std::printf(" %lld", static_cast<long long>(c->case_index));
@@ -294,7 +298,7 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
   depth_cdf.title = analysis::escape_markup(own_name) + ": crevasse depths of " + std::to_string(depths.size()) + " case(s)";
   depth_cdf.x_label = "D_p/H_i";
   const auto depth_files = write_png_and_svg(analysis::empirical_cdf_figure(depths, depth_cdf),
-                                             fs::path(opt.out_dir) / "depth_cdf");
+                                             fs::path(opt.out_dir) / (file_prefix + "depth_cdf"));
   written.insert(written.end(), depth_files.begin(), depth_files.end());
   std::printf("%s: depth CDFs of the same case(s)\n", depth_files.front().c_str());
   return written;

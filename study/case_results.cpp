@@ -3,6 +3,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
+#include "analysis/crevasse_measure.hpp"
 #include "engine/error.hpp"
 #include "engine/json_input.hpp"
 
@@ -24,6 +25,14 @@ const char* quantity_key(Quantity q) {
   return q == Quantity::spacing ? "spacing_over_h" : "depth_over_h";
 }
 const char* quantity_symbol(Quantity q) { return q == Quantity::spacing ? "L_p/H_i" : "D_p/H_i"; }
+
+std::string fit_quantity_key(Quantity q, CaseReading reading) {
+  return (reading == CaseReading::ramp_ice ? "ramp_ice_" : "") + std::string(quantity_key(q));
+}
+
+const char* reading_label(CaseReading reading) {
+  return reading == CaseReading::ramp_ice ? " (ramp ice)" : "";
+}
 
 std::optional<double> CaseRecord::group(const FitGroup& g) const {
   for (std::size_t i = 0; i < std::size(kFitGroups); ++i)
@@ -48,7 +57,65 @@ std::string CaseRecord::missing_reason(Quantity q) const {
   return "no value";
 }
 
-std::vector<CaseRecord> read_case_records(Store& store) {
+namespace {
+
+// Re-reads each measured case from its crevasses in the draped window's first L_s: their count,
+// depths and the spacings the measurement kept between two of them, with quartiles over H_i.
+// Status, groups and flags stay the case's.
+void read_ramp_ice(Store& store, const std::string& where, std::vector<CaseRecord>& cases) {
+  sqlite3* db = store.handle();
+  {
+    Statement s(db, "SELECT json_extract(measurement_json, '$.frame') FROM study WHERE id = 1");
+    const std::string frame = s.step() ? s.text(0) : "";
+    if (frame != "draped")
+      throw InputError("--ramp-ice: " + where + " was measured in the " +
+                       (frame.empty() ? std::string("default") : "'" + frame + "'") +
+                       " frame; the ramp's ice is read in the draped frame only (a study with "
+                       "\"protocol\": \"initiation\" or \"measurement\": {\"frame\": \"draped\"})");
+  }
+  Statement window(db,
+                   "SELECT m.window_min_x_m, json_extract(c.scene_json, '$.bed.step_length') "
+                   "FROM summaries m JOIN cases c USING (case_id) WHERE case_id = ?");
+  Statement cracks(
+      db, "SELECT x_m, depth_m, spacing_to_next_m FROM crevasses WHERE case_id = ? ORDER BY x_m");
+  for (CaseRecord& r : cases) {
+    if (!r.has_summary) continue;
+    window.reset();
+    window.bind(1, r.case_id);
+    if (!window.step() || window.is_null(1))
+      throw InputError("--ramp-ice: " + where + ": case " + r.label +
+                       " has no bed.step_length in its scene, so no ramp");
+    const double end = window.real(0) + window.real(1);
+    std::vector<double> depths, spacings;
+    std::optional<double> spacing_before;  // the previous crevasse's spacing to this one
+    cracks.reset();
+    cracks.bind(1, r.case_id);
+    while (cracks.step() && cracks.real(0) <= end) {
+      if (spacing_before) spacings.push_back(*spacing_before);
+      depths.push_back(cracks.real(1));
+      spacing_before = cracks.optional_real(2);
+    }
+    const double inv_h = 1.0 / r.thickness_m();
+    const auto over_h = [inv_h](const std::vector<double>& v) {
+      std::array<std::optional<double>, 3> q;
+      if (v.empty()) return q;
+      const analysis::QuartileSummary s = analysis::quartiles(v);
+      q = {s.q25 * inv_h, s.median * inv_h, s.q75 * inv_h};
+      return q;
+    };
+    r.crevasse_count = static_cast<std::int64_t>(depths.size());
+    r.spacing_count = static_cast<std::int64_t>(spacings.size());
+    r.no_crevasse = depths.empty();
+    r.spacing_over_h = over_h(spacings);
+    r.depth_over_h = over_h(depths);
+    r.spacings_m = std::move(spacings);
+    r.depths_m = std::move(depths);
+  }
+}
+
+}  // namespace
+
+std::vector<CaseRecord> read_case_records(Store& store, CaseReading reading) {
   sqlite3* db = store.handle();
   const std::string where = store.path().string();
   {
@@ -114,6 +181,7 @@ std::vector<CaseRecord> read_case_records(Store& store) {
     out.push_back(std::move(r));
   }
   if (out.empty()) throw InputError(where + ": the study has no cases");
+  if (reading == CaseReading::ramp_ice) read_ramp_ice(store, where, out);
   return out;
 }
 

@@ -40,6 +40,16 @@ inline constexpr Quantity kQuantities[] = {Quantity::spacing, Quantity::depth};
 const char* quantity_key(Quantity q);     // "spacing_over_h", "depth_over_h" (fits table)
 const char* quantity_symbol(Quantity q);  // "L_p/H_i", "D_p/H_i"
 
+// Which crevasses of each case are read (docs/measurement.md, "The ramp's ice").
+enum class CaseReading {
+  window,    // the measurement's whole window: the stored summary
+  ramp_ice,  // draped frame: the window's first L_s, the ice that lay over the ramp at the start
+};
+// The fits table's key of `q` read so: "spacing_over_h", "ramp_ice_spacing_over_h", ...
+std::string fit_quantity_key(Quantity q, CaseReading reading);
+// "" or " (ramp ice)": what a table or figure adds to its title.
+const char* reading_label(CaseReading reading);
+
 struct CaseRecord {
   std::string case_id;
   std::int64_t case_index = 0;
@@ -75,8 +85,9 @@ struct CaseRecord {
 };
 
 // Every case of the database, by case_index. Throws InputError when the database holds no
-// study or no cases.
-std::vector<CaseRecord> read_case_records(Store& store);
+// study or no cases, and for CaseReading::ramp_ice when the study was not measured in the draped
+// frame.
+std::vector<CaseRecord> read_case_records(Store& store, CaseReading reading = CaseReading::window);
 
 // The study's name, or `fallback` when the database holds no study.
 std::string study_name(Store& store, const std::string& fallback);

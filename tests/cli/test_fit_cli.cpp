@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "analysis/measurement_io.hpp"
+#include "study/case_results.hpp"
 #include "study/field_observations.hpp"
 #include "study/fits_table.hpp"
 #include "../study/study_test_support.hpp"
@@ -387,6 +388,76 @@ TEST(FitCli, StatusGivesTheShareOfCrevassesDeeperThanHalfTheIce) {
   EXPECT_EQ(share["0.1057"], "0%") << status.out;
   EXPECT_EQ(share["0.2236"], "100%") << status.out;
   EXPECT_EQ(share["1"], "100%") << status.out;
+}
+
+// --ramp-ice reads each case's crevasses in the draped window's first L_s (the ice that lay over
+// the ramp at the start), fits and stores them beside the window's own fits, and draws and
+// calibrates from them; a study measured in another frame is refused.
+TEST(FitCli, RampIceReadsTheDrapedWindowsFirstStepLengthBesideTheWindow) {
+  test::ScratchDir dir("fit");
+  // H_i = L_s = 100 m. Case i's 7 crevasses stand at x = 0, 24, 51, 79.5, 109.5, 141, 174 m
+  // stretched by 1 + 0.02 i (L_p = 0.3 (1 + 0.02 i) H_i over the window), so the first four, with
+  // three spacings, lie within the first L_s of the window (which starts at x = 0) in every case.
+  const auto stretched = [](const StudyCase& c) {
+    FakeResult f;
+    f.spacing_over_h = 0.3 * (1.0 + 0.02 * static_cast<double>(c.index));
+    f.depth_over_h = 0.2 * std::sqrt(c.groups.cohesion_ratio / 0.2);
+    return f;
+  };
+  write_synthetic_db(dir / "d.db", 6, {100.0}, stretched,
+                     [](nlohmann::json& j) { j["measurement"] = {{"frame", "draped"}}; });
+  {
+    Store store = Store::open_reader(dir / "d.db");
+    const std::vector<CaseRecord> window = read_case_records(store);
+    const std::vector<CaseRecord> ramp = read_case_records(store, CaseReading::ramp_ice);
+    ASSERT_EQ(ramp.size(), 6u);
+    for (std::size_t i = 0; i < ramp.size(); ++i) {
+      EXPECT_EQ(window[i].crevasse_count, 7);
+      EXPECT_EQ(ramp[i].crevasse_count, 4) << i;
+      EXPECT_EQ(ramp[i].spacing_count, 3) << i;
+      EXPECT_EQ(ramp[i].depths_m.size(), 4u) << i;
+      EXPECT_EQ(ramp[i].cohesion_ratio(), window[i].cohesion_ratio());
+    }
+    // Case 0: spacings 24, 27, 28.5 m; type-7 quartiles 25.5, 27, 27.75 m; the window's median 30 m.
+    const CaseRecord& first = ramp.front();
+    ASSERT_EQ(first.spacings_m.size(), 3u);
+    EXPECT_NEAR(first.spacings_m[0], 24.0, 1e-9);
+    EXPECT_NEAR(first.spacings_m[2], 28.5, 1e-9);
+    EXPECT_NEAR(first.spacing_over_h[0].value_or(0.0), 0.255, 1e-12);
+    EXPECT_NEAR(first.spacing_over_h[1].value_or(0.0), 0.27, 1e-12);
+    EXPECT_NEAR(first.spacing_over_h[2].value_or(0.0), 0.2775, 1e-12);
+    EXPECT_NEAR(window.front().spacing_over_h[1].value_or(0.0), 0.3, 1e-12);
+  }
+  ASSERT_EQ(test::run_cli(dir.path(), "fit d.db").code, 0);
+  const test::CliResult fit = test::run_cli(dir.path(), "fit d.db --ramp-ice");
+  ASSERT_EQ(fit.code, 0) << fit.err;
+  EXPECT_NE(fit.out.find("(ramp ice)"), std::string::npos) << fit.out;
+  // Each reading's rows under its own key; the ramp's medians span 0.27-0.297, the window's 0.3-0.33.
+  EXPECT_EQ(test::dump_rows(dir / "d.db",
+                            "SELECT quantity || ' ' || round(y_min, 4) || ' ' || round(y_max, 4) "
+                            "FROM fits WHERE model = 'single' AND quantity LIKE '%spacing%' "
+                            "ORDER BY quantity"),
+            (std::vector<std::string>{"ramp_ice_spacing_over_h 0.27 0.297",
+                                      "spacing_over_h 0.3 0.33"}));
+  const test::CliResult plot = test::run_cli(dir.path(), "plot d.db --out figs --ramp-ice");
+  ASSERT_EQ(plot.code, 0) << plot.err;
+  EXPECT_NE(test::read_file(dir / "figs" / "ramp_ice_spacing_vs_cohesion_ratio.svg").find("ramp ice"),
+            std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(dir / "figs" / "spacing_vs_cohesion_ratio.svg"));
+  const test::CliResult predict =
+      test::run_cli(dir.path(), "predict --db d.db --cohesion 100000 --thickness 100 --ramp-ice");
+  ASSERT_EQ(predict.code, 0) << predict.err;
+  EXPECT_NE(predict.out.find("crevasse fit --ramp-ice"), std::string::npos) << predict.out;
+
+  // Measured in the default frame: refused, one line, nothing stored.
+  write_synthetic_db(dir / "w.db", 6, {100.0}, stretched);
+  const test::CliResult refused = test::run_cli(dir.path(), "fit w.db --ramp-ice");
+  expect_one_line_error(refused, "--ramp-ice");
+  EXPECT_NE(refused.err.find("draped"), std::string::npos) << refused.err;
+  EXPECT_EQ(test::dump_rows(dir / "w.db",
+                            "SELECT count(*) FROM sqlite_master WHERE name = 'fits'")
+                .at(0),
+            "0");
 }
 
 // --add-cases draws another study's cases on the diagram under their study's name and field
