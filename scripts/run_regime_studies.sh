@@ -40,6 +40,13 @@ fit_and_plot() {
   # The field sites against the initiation study's laws, with the literature strengths under the table.
   $C calibrate --db $R/regime_initiation.db --observations studies/field/observations.json \
     --csv $R/regime_initiation_figures/field_calibration.csv > $R/regime_initiation_figures/field_calibration.txt
+  # The same read in the ice that lay over the ramp (docs/measurement.md, "The ramp's ice"): its laws,
+  # figures named ramp_ice_*, the spacing CDFs of the strength regime's rows over c/(rho_i g) (cases
+  # 12, 13: Π = 0.075, 0.1 at 400 m; 22, 23: the same at 600 m), and the calibration from them.
+  $C fit $R/regime_initiation.db --ramp-ice
+  $C plot $R/regime_initiation.db --out $R/regime_initiation_figures --ramp-ice --cdf-normalise strength --cdf-cases 12 13 22 23
+  $C calibrate --db $R/regime_initiation.db --observations studies/field/observations.json --ramp-ice \
+    --csv $R/regime_initiation_figures/ramp_ice_field_calibration.csv > $R/regime_initiation_figures/ramp_ice_field_calibration.txt
 }
 
 $C study studies/regime_initiation_replicas.json --db $R/regime_initiation_replicas.db --keep-particles \
