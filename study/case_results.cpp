@@ -82,9 +82,10 @@ void read_ramp_ice(Store& store, const std::string& where, std::vector<CaseRecor
     if (!r.has_summary) continue;
     window.reset();
     window.bind(1, r.case_id);
-    if (!window.step() || window.is_null(1))
+    if (!window.step() || window.is_null(1) || !(window.real(1) > 0.0))
       throw InputError("--ramp-ice: " + where + ": case " + r.label +
-                       " has no bed.step_length in its scene, so no ramp");
+                       " has no ramp (bed.step_length absent or 0: a vertical step); allowed: "
+                       "studies whose every step has a ramp");
     const double end = window.real(0) + window.real(1);
     std::vector<double> depths, spacings;
     std::optional<double> spacing_before;  // the previous crevasse's spacing to this one

@@ -458,6 +458,14 @@ TEST(FitCli, RampIceReadsTheDrapedWindowsFirstStepLengthBesideTheWindow) {
                             "SELECT count(*) FROM sqlite_master WHERE name = 'fits'")
                 .at(0),
             "0");
+  // A vertical step has no ramp: refused, not read as "no crevasse" everywhere.
+  write_synthetic_db(dir / "v.db", 6, {100.0}, stretched, [](nlohmann::json& j) {
+    j["measurement"] = {{"frame", "draped"}};
+    j["fixed"] = {{"step_length_ratio", 0.0}, {"step_height_ratio", 1.0}};
+  });
+  const test::CliResult vertical = test::run_cli(dir.path(), "fit v.db --ramp-ice");
+  expect_one_line_error(vertical, "--ramp-ice");
+  EXPECT_NE(vertical.err.find("vertical step"), std::string::npos) << vertical.err;
 }
 
 // --add-cases draws another study's cases on the diagram under their study's name and field
