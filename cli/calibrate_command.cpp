@@ -115,8 +115,8 @@ StudyLaws load_laws(const std::string& db_path, bool ramp_ice) {
   } else {
     laws.source = std::string("no fits table yet: laws fitted now with the defaults (crevasse fit") +
                   (ramp_ice ? " --ramp-ice" : "") + " stores them)";
-    spacing = fit_records(fit_study(cases, Quantity::spacing, pi), "");
-    depth = fit_records(fit_study(cases, Quantity::depth, pi), "");
+    spacing = fit_records(fit_study(cases, Quantity::spacing, pi), "", reading);
+    depth = fit_records(fit_study(cases, Quantity::depth, pi), "", reading);
   }
   laws.spacing = laws_from_records(spacing);
   laws.depth = laws_from_records(depth);

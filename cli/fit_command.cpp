@@ -137,8 +137,7 @@ int fit_command(const FitCommandOptions& opt) {
     for (Quantity q : kQuantities) {
       const StudyFit fit =
           fit_study(cases, q, *group, q == Quantity::spacing ? spacing_options : depth_options);
-      auto rows = fit_records(fit, now);
-      for (FitRecord& r : rows) r.quantity = fit_quantity_key(q, reading);
+      const auto rows = fit_records(fit, now, reading);
       records.insert(records.end(), rows.begin(), rows.end());
       notes.push_back(std::string(quantity_symbol(q)) + ": " + fit.accounting() +
                       (fit.options.fixed_b1 || fit.options.fixed_b2

@@ -39,14 +39,16 @@ def cases(db_path, all_steps, lead):
          window_min, c, rho_g, step_length) in rows:
         if not all_steps and (abs((slope or 0.5) - 0.5) > 1e-9 or abs(ls_ratio - 1.0) > 1e-9):
             continue
+        # As `crevasse fit --ramp-ice` reads them: the spacings the measurement kept between two
+        # crevasses of the leading window.
         lead_cracks = con.execute(
-            "select x_m, depth_m from crevasses where case_id = ? and x_m <= ? order by x_m",
-            (case_id, window_min + lead * step_length)).fetchall()
-        pairs = [b[0] - a[0] for a, b in zip(lead_cracks, lead_cracks[1:])]
+            "select x_m, depth_m, spacing_to_next_m from crevasses where case_id = ? and x_m <= ? "
+            "order by x_m", (case_id, window_min + lead * step_length)).fetchall()
+        pairs = [s for _, _, s in lead_cracks[:-1] if s is not None]
         out.append(dict(db=db_path, index=index, seed=seed, h=h, pi=pi, c=c, rho_g=rho_g,
                         count=count, l_med=l_med, l_25=l_25, l_75=l_75, d_med=d_med,
                         under=bool(under), lead_count=len(lead_cracks), lead_l=median(pairs),
-                        lead_d=median([d for _, d in lead_cracks])))
+                        lead_d=median([d for _, d, _ in lead_cracks])))
     con.close()
     return out
 

@@ -161,9 +161,10 @@ analysis::PowerLaw FitRecord::law() const {
   return law;
 }
 
-std::vector<FitRecord> fit_records(const StudyFit& fit, const std::string& created_at) {
+std::vector<FitRecord> fit_records(const StudyFit& fit, const std::string& created_at,
+                                   CaseReading reading) {
   FitRecord base;
-  base.quantity = quantity_key(fit.quantity);
+  base.quantity = fit_quantity_key(fit.quantity, reading);
   base.group_name = fit.group->name;
   base.level = fit.options.level;
   base.fixed_exponents = fixed_exponents_text(fit.options);

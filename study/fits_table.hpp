@@ -47,7 +47,9 @@ struct FitRecord {
 
 // Rows for one StudyFit: the single law ("all") and the broken line's two segments ("below",
 // "above"), or a not_enough_data row in place of a model that could not be fitted.
-std::vector<FitRecord> fit_records(const StudyFit& fit, const std::string& created_at);
+// Keyed by fit_quantity_key(fit.quantity, reading).
+std::vector<FitRecord> fit_records(const StudyFit& fit, const std::string& created_at,
+                                   CaseReading reading = CaseReading::window);
 
 // Replaces the rows of (quantity, group_name) by `records` in one transaction, creating the
 // table when absent.

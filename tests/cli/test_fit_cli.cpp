@@ -36,7 +36,8 @@ struct FakeResult {
 void write_synthetic_db(const std::filesystem::path& db, int n_pi,
                         const std::vector<double>& thicknesses,
                         const std::function<FakeResult(const StudyCase&)>& make,
-                        const std::function<void(nlohmann::json&)>& edit = {}) {
+                        const std::function<void(nlohmann::json&)>& edit = {},
+                        double window_start_m = 0.0) {
   nlohmann::json j = test::tiny_study(n_pi, 100, "synthetic");
   j["sweep"]["thickness"] = thicknesses;
   if (n_pi == 1) j["sweep"]["cohesion_ratio"] = {0.2};
@@ -66,7 +67,7 @@ void write_synthetic_db(const std::filesystem::path& db, int n_pi,
       } else {
         const double l = f.spacing_over_h * h, d = f.depth_over_h * h;
         const std::vector<double> factors = {0.8, 0.9, 0.95, 1.0, 1.05, 1.1, 1.2};
-        double x = 0.0;
+        double x = window_start_m;
         for (std::size_t k = 0; k < factors.size(); ++k) {
           analysis::Crevasse cr;
           cr.x_m = x;
@@ -80,6 +81,8 @@ void write_synthetic_db(const std::filesystem::path& db, int n_pi,
           }
           m.crevasses.push_back(cr);
         }
+        m.settings.window_min_x_m = window_start_m;
+        m.settings.window_max_x_m = x;
         m.flags.has_spacing = true;
         m.spacing_m = analysis::QuartileSummary{0.925 * l, l, 1.075 * l};
         m.spacing_over_h = analysis::QuartileSummary{0.925 * f.spacing_over_h, f.spacing_over_h,
@@ -395,17 +398,19 @@ TEST(FitCli, StatusGivesTheShareOfCrevassesDeeperThanHalfTheIce) {
 // calibrates from them; a study measured in another frame is refused.
 TEST(FitCli, RampIceReadsTheDrapedWindowsFirstStepLengthBesideTheWindow) {
   test::ScratchDir dir("fit");
-  // H_i = L_s = 100 m. Case i's 7 crevasses stand at x = 0, 24, 51, 79.5, 109.5, 141, 174 m
-  // stretched by 1 + 0.02 i (L_p = 0.3 (1 + 0.02 i) H_i over the window), so the first four, with
-  // three spacings, lie within the first L_s of the window (which starts at x = 0) in every case.
+  // H_i = L_s = 100 m. Case i's 7 crevasses stand 0, 24, 51, 79.5, 109.5, 141, 174 m past the
+  // window's start at x = 1000 m, stretched by 1 + 0.02 i (L_p = 0.3 (1 + 0.02 i) H_i over the
+  // window), so the first four, with three spacings, lie within its first L_s in every case; read
+  // from x = 0 none would, read from the window's end all seven.
   const auto stretched = [](const StudyCase& c) {
     FakeResult f;
     f.spacing_over_h = 0.3 * (1.0 + 0.02 * static_cast<double>(c.index));
     f.depth_over_h = 0.2 * std::sqrt(c.groups.cohesion_ratio / 0.2);
     return f;
   };
-  write_synthetic_db(dir / "d.db", 6, {100.0}, stretched,
-                     [](nlohmann::json& j) { j["measurement"] = {{"frame", "draped"}}; });
+  write_synthetic_db(
+      dir / "d.db", 6, {100.0}, stretched,
+      [](nlohmann::json& j) { j["measurement"] = {{"frame", "draped"}}; }, 1000.0);
   {
     Store store = Store::open_reader(dir / "d.db");
     const std::vector<CaseRecord> window = read_case_records(store);
