@@ -98,8 +98,8 @@ struct StudyLaws {
   double thickness_min = 0.0, thickness_max = 0.0;  // H_i the study ran
 };
 
-StudyLaws load_laws(const std::string& db_path, bool ramp_ice) {
-  const CaseReading reading = ramp_ice ? CaseReading::ramp_ice : CaseReading::window;
+StudyLaws load_laws(const std::string& db_path, CaseReading reading) {
+  const std::string flag = reading == CaseReading::window ? "" : std::string(" ") + reading_flag(reading);
   Store store = Store::open_reader(db_path);
   const std::vector<CaseRecord> cases = read_case_records(store, reading);
   StudyLaws laws;
@@ -111,10 +111,10 @@ StudyLaws load_laws(const std::string& db_path, bool ramp_ice) {
       read_fit_records(store, fit_quantity_key(Quantity::depth, reading), pi.name);
   if (!spacing.empty()) {
     laws.source = std::string("laws from the fits table (crevasse fit") +
-                  (ramp_ice ? " --ramp-ice" : "") + ", " + spacing.front().created_at + ")";
+                  flag + ", " + spacing.front().created_at + ")";
   } else {
     laws.source = std::string("no fits table yet: laws fitted now with the defaults (crevasse fit") +
-                  (ramp_ice ? " --ramp-ice" : "") + " stores them)";
+                  flag + " stores them)";
     spacing = fit_records(fit_study(cases, Quantity::spacing, pi), "", reading);
     depth = fit_records(fit_study(cases, Quantity::depth, pi), "", reading);
   }
@@ -208,7 +208,7 @@ int calibrate_observations(const CalibrateCommandOptions& opt) {
   const FieldObservationFile file = load_field_observations(opt.observations_path);
   const std::vector<FieldObservation>& sites = file.sites;
   const std::vector<LiteratureStrength>& literature = file.literature;
-  const StudyLaws laws = load_laws(opt.db_path, opt.ramp_ice);
+  const StudyLaws laws = load_laws(opt.db_path, opt.reading);
   const analysis::CalibrationOptions options = calibration_options(laws, opt.level);
   print_header(laws, opt.level);
   std::printf("observations: %s (%zu sites)\n\n", opt.observations_path.c_str(), sites.size());
@@ -337,7 +337,7 @@ int calibrate_command(const CalibrateCommandOptions& opt) {
     obs.spacing_q75_m = q75;
   }
 
-  const StudyLaws laws = load_laws(opt.db_path, opt.ramp_ice);
+  const StudyLaws laws = load_laws(opt.db_path, opt.reading);
   const analysis::CalibrationOptions options = calibration_options(laws, opt.level);
 
   const std::vector<Answer> answers = invert_in_every_regime(laws, obs, options, "--spacing: ");
@@ -393,7 +393,7 @@ int predict_command(const PredictCommandOptions& opt) {
   check_confidence_level(opt.level);
   positive(opt.tensile_strength_pa, "--cohesion");
   positive(opt.thickness_m, "--thickness");
-  const StudyLaws laws = load_laws(opt.db_path, opt.ramp_ice);
+  const StudyLaws laws = load_laws(opt.db_path, opt.reading);
   const double pi = analysis::cohesion_ratio(opt.tensile_strength_pa, opt.thickness_m, laws.ice);
   const auto holds = [&](const QuantityRegime& r) { return r.pi_min <= pi && pi <= r.pi_max; };
   const auto& spacing = laws.spacing.regimes;

@@ -8,6 +8,8 @@
 #include <optional>
 #include <string>
 
+#include "study/case_results.hpp"
+
 namespace crevasse {
 
 struct CalibrateCommandOptions {
@@ -18,7 +20,7 @@ struct CalibrateCommandOptions {
   double level = 0.95;
   std::string observations_path;  // --observations FILE: every site of the file, as a table
   std::string csv_path;           // --csv PATH: the table also as CSV (with --observations)
-  bool ramp_ice = false;          // the laws fitted to the ramp's ice (crevasse fit --ramp-ice)
+  CaseReading reading = CaseReading::window;  // the laws fitted so (crevasse fit --ramp-ice, ...)
 };
 
 struct PredictCommandOptions {
@@ -26,7 +28,7 @@ struct PredictCommandOptions {
   double tensile_strength_pa = 0.0;
   double thickness_m = 0.0;
   double level = 0.95;
-  bool ramp_ice = false;
+  CaseReading reading = CaseReading::window;
 };
 
 int calibrate_command(const CalibrateCommandOptions& opt);

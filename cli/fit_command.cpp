@@ -104,7 +104,7 @@ int fit_command(const FitCommandOptions& opt) {
   if (!opt.fixed_depth_exponents.empty())
     parse_fixed_exponents(opt.fixed_depth_exponents, "--fixed-depth-exponents", depth_options);
 
-  const CaseReading reading = opt.ramp_ice ? CaseReading::ramp_ice : CaseReading::window;
+  const CaseReading reading = opt.reading;
   std::vector<CaseRecord> cases;
   std::string title;
   {

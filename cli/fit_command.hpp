@@ -3,6 +3,8 @@
 // power law and a broken line (docs/fits.md), prints the table and stores it in the database's
 // `fits` table (docs/database.md).
 #include <string>
+
+#include "study/case_results.hpp"
 #include <vector>
 
 namespace crevasse {
@@ -16,7 +18,8 @@ struct FitCommandOptions {
   bool exclude_fragmented = false;
   bool include_under_resolved = false;  // fit cases with c/(ρ_i g) < 3 dx too
   bool no_store = false;  // print only
-  bool ramp_ice = false;  // the draped window's first L_s only (docs/measurement.md, "The ramp's ice")
+  // The whole window, the ramp's ice or the window clear of the front (docs/measurement.md).
+  CaseReading reading = CaseReading::window;
 };
 
 int fit_command(const FitCommandOptions& opt);

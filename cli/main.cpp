@@ -30,6 +30,18 @@ namespace {
 
 // A message as one printable line of bounded length: it may echo user input (a key, a value), and
 // neither a terminal escape nor a megabyte of a bad value belongs on the user's terminal.
+// --ramp-ice and --clear-of-front, one or neither: which crevasses of each case are read
+// (docs/measurement.md, "The ramp's ice", "Clear of the front").
+void add_reading_flags(CLI::App* command, crevasse::CaseReading& reading, const std::string& ramp_help,
+                       const std::string& front_help) {
+  CLI::Option* ramp = command->add_flag_callback(
+      "--ramp-ice", [&reading] { reading = crevasse::CaseReading::ramp_ice; }, ramp_help);
+  CLI::Option* front = command->add_flag_callback(
+      "--clear-of-front", [&reading] { reading = crevasse::CaseReading::clear_of_front; },
+      front_help);
+  ramp->excludes(front);
+}
+
 std::string one_line(const std::string& what) {
   constexpr std::size_t kMaxMessage = 600;
   std::string s;
@@ -138,7 +150,7 @@ int run_command_line(int argc, char** argv) {
   fit->add_flag("--exclude-fragmented", fit_opt.exclude_fragmented, "Leave out cases flagged fragmented");
   fit->add_flag("--include-under-resolved", fit_opt.include_under_resolved, "Fit cases flagged under_resolved (c/(rho_i g) < 3 dx) too; by default they are left out");
   fit->add_flag("--no-store", fit_opt.no_store, "Print the table only; do not write the fits table");
-  fit->add_flag("--ramp-ice", fit_opt.ramp_ice, "Read only the draped window's first L_s, the ice that lay over the ramp at the start (docs/measurement.md, \"The ramp's ice\"); stored beside the window's fits as ramp_ice_*");
+  add_reading_flags(fit, fit_opt.reading, "Read only the draped window's first L_s, the ice that lay over the ramp at the start (docs/measurement.md, \"The ramp's ice\"); stored beside the window's fits as ramp_ice_*", "Read the window but its last H_i, the ice next to the outflow's face (docs/measurement.md, \"Clear of the front\"); stored beside the window's fits as clear_of_front_*");
 
   crevasse::PlotCommandOptions plot_opt;
   auto* plot = app.add_subcommand("plot", "Regime diagrams and spacing CDFs of a study as PNG and SVG");
@@ -153,7 +165,7 @@ int run_command_line(int argc, char** argv) {
   plot->add_option("--cdf-normalise", plot_opt.cdf_normalise, "Spacing CDFs normalised by: median (of each case), thickness (H_i), bending (sqrt(c H_i/(rho_i g))), strength (c/(rho_i g)), none; the depth CDFs of the same cases are over H_i");
   plot->add_option("--add-cases", plot_opt.add_cases, "Other study databases whose cases are drawn too, not fitted (e.g. 3D cases on the 2D diagram)")->delimiter(',');
   plot->add_flag("--include-under-resolved", plot_opt.include_under_resolved, "Fit and draw under_resolved cases (c/(rho_i g) < 3 dx) like the others; by default they are drawn hollow and not fitted");
-  plot->add_flag("--ramp-ice", plot_opt.ramp_ice, "Read only the draped window's first L_s, the ice that lay over the ramp at the start (docs/measurement.md, \"The ramp's ice\"); figures named ramp_ice_*");
+  add_reading_flags(plot, plot_opt.reading, "Read only the draped window's first L_s, the ice that lay over the ramp at the start (docs/measurement.md, \"The ramp's ice\"); figures named ramp_ice_*", "Read the window but its last H_i, the ice next to the outflow's face (docs/measurement.md, \"Clear of the front\"); figures named clear_of_front_*");
   plot->add_flag("--exclude-fragmented", plot_opt.exclude_fragmented, "Leave fragmented cases out of the drawn fit, marked on the bottom edge (default: as the fits table was made)");
 
   crevasse::CalibrateCommandOptions calibrate_opt;
@@ -166,7 +178,7 @@ int run_command_line(int argc, char** argv) {
   calibrate->add_option("--level", calibrate_opt.level, "Confidence level (default 0.95)");
   calibrate->add_option("--observations", calibrate_opt.observations_path, "Field observations file (studies/field/observations.json): every site as a table, instead of --spacing");
   calibrate->add_option("--csv", calibrate_opt.csv_path, "With --observations: write the table as CSV too");
-  calibrate->add_flag("--ramp-ice", calibrate_opt.ramp_ice, "Use the laws fitted to the ramp's ice (crevasse fit --ramp-ice)");
+  add_reading_flags(calibrate, calibrate_opt.reading, "Use the laws fitted to the ramp's ice (crevasse fit --ramp-ice)", "Use the laws fitted clear of the front (crevasse fit --clear-of-front)");
 
   crevasse::PredictCommandOptions predict_opt;
   auto* predict = app.add_subcommand("predict", "Predict crevasse spacing and depth for a tensile strength and thickness");
@@ -174,7 +186,7 @@ int run_command_line(int argc, char** argv) {
   predict->add_option("--cohesion", predict_opt.tensile_strength_pa, "Tensile strength c [Pa]")->required();
   predict->add_option("--thickness", predict_opt.thickness_m, "Ice thickness H_i [m]")->required();
   predict->add_option("--level", predict_opt.level, "Confidence level (default 0.95)");
-  predict->add_flag("--ramp-ice", predict_opt.ramp_ice, "Use the laws fitted to the ramp's ice (crevasse fit --ramp-ice)");
+  add_reading_flags(predict, predict_opt.reading, "Use the laws fitted to the ramp's ice (crevasse fit --ramp-ice)", "Use the laws fitted clear of the front (crevasse fit --clear-of-front)");
 
   crevasse::AccuracyCommandOptions accuracy_opt;
   auto* accuracy = app.add_subcommand("accuracy", "Accuracy against cost of a study over the numerics (studies/accuracy_flowing.json): table and figure");

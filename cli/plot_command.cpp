@@ -119,11 +119,11 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
                      "' is not one of median, thickness, bending, strength, none");
 
   Store store = Store::open_reader(opt.db_path);
-  const CaseReading reading = opt.ramp_ice ? CaseReading::ramp_ice : CaseReading::window;
+  const CaseReading reading = opt.reading;
   const std::vector<CaseRecord> cases = read_case_records(store, reading);
   const std::string own_name = study_name_with_field(store, "study") + reading_label(reading);
-  // Both readings' figures can share a folder.
-  const std::string file_prefix = reading == CaseReading::ramp_ice ? "ramp_ice_" : "";
+  // Every reading's figures can share a folder.
+  const std::string file_prefix = reading_prefix(reading);
   std::vector<const CaseRecord*> cdf_cases;
   for (std::int64_t index : opt.cdf_cases) {
     const auto it = std::find_if(cases.begin(), cases.end(),

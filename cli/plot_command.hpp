@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+
+#include "study/case_results.hpp"
 #include <vector>
 
 namespace crevasse {
@@ -22,7 +24,7 @@ struct PlotCommandOptions {
   double level = 0.95;
   bool exclude_fragmented = false;
   bool include_under_resolved = false;  // fit cases with c/(ρ_i g) < 3 dx too
-  bool ramp_ice = false;  // the draped window's first L_s only, with its own stored fits
+  CaseReading reading = CaseReading::window;  // as crevasse fit, with that reading's stored fits
   // Other study databases whose cases are drawn on the regime diagrams too (not fitted),
   // labelled "<their study name>: ...", e.g. 3D cases on their 2D study's diagram.
   std::vector<std::string> add_cases;

@@ -47,6 +47,12 @@ fit_and_plot() {
   $C plot $R/regime_initiation.db --out $R/regime_initiation_figures --ramp-ice --cdf-normalise strength --cdf-cases 12 13 22 23
   $C calibrate --db $R/regime_initiation.db --observations studies/field/observations.json --ramp-ice \
     --csv $R/regime_initiation_figures/ramp_ice_field_calibration.csv > $R/regime_initiation_figures/ramp_ice_field_calibration.txt
+  # The window but its last H_i, where the outflow's free face breaks the floor ice (docs/measurement.md,
+  # "Clear of the front"): its laws, figures named clear_of_front_*, and the calibration from them.
+  $C fit $R/regime_initiation.db --clear-of-front
+  $C plot $R/regime_initiation.db --out $R/regime_initiation_figures --clear-of-front --cdf-normalise bending --cdf-cases 12 13 6 16
+  $C calibrate --db $R/regime_initiation.db --observations studies/field/observations.json --clear-of-front \
+    --csv $R/regime_initiation_figures/clear_of_front_field_calibration.csv > $R/regime_initiation_figures/clear_of_front_field_calibration.txt
 }
 
 $C study studies/regime_initiation_replicas.json --db $R/regime_initiation_replicas.db --keep-particles \

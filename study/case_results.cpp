@@ -26,12 +26,35 @@ const char* quantity_key(Quantity q) {
 }
 const char* quantity_symbol(Quantity q) { return q == Quantity::spacing ? "L_p/H_i" : "D_p/H_i"; }
 
+const char* reading_prefix(CaseReading reading) {
+  switch (reading) {
+    case CaseReading::ramp_ice: return "ramp_ice_";
+    case CaseReading::clear_of_front: return "clear_of_front_";
+    case CaseReading::window: break;
+  }
+  return "";
+}
+
 std::string fit_quantity_key(Quantity q, CaseReading reading) {
-  return (reading == CaseReading::ramp_ice ? "ramp_ice_" : "") + std::string(quantity_key(q));
+  return reading_prefix(reading) + std::string(quantity_key(q));
 }
 
 const char* reading_label(CaseReading reading) {
-  return reading == CaseReading::ramp_ice ? " (ramp ice)" : "";
+  switch (reading) {
+    case CaseReading::ramp_ice: return " (ramp ice)";
+    case CaseReading::clear_of_front: return " (clear of the front)";
+    case CaseReading::window: break;
+  }
+  return "";
+}
+
+const char* reading_flag(CaseReading reading) {
+  switch (reading) {
+    case CaseReading::ramp_ice: return "--ramp-ice";
+    case CaseReading::clear_of_front: return "--clear-of-front";
+    case CaseReading::window: break;
+  }
+  return "";
 }
 
 std::optional<double> CaseRecord::group(const FitGroup& g) const {
@@ -59,22 +82,30 @@ std::string CaseRecord::missing_reason(Quantity q) const {
 
 namespace {
 
-// Re-reads each measured case from its crevasses in the draped window's first L_s: their count,
+// Re-reads each measured case from its stored crevasses in part of its window: their count,
 // depths and the spacings the measurement kept between two of them, with quartiles over H_i.
-// Status, groups and flags stay the case's.
-void read_ramp_ice(Store& store, const std::string& where, std::vector<CaseRecord>& cases) {
+// Status, groups and flags stay the case's. The part: the window's first L_s (ramp_ice), or the
+// window but its last H_i (clear_of_front).
+void read_part_of_window(Store& store, const std::string& where, CaseReading reading,
+                         std::vector<CaseRecord>& cases) {
   sqlite3* db = store.handle();
+  const std::string flag = reading_flag(reading);
   {
     Statement s(db, "SELECT json_extract(measurement_json, '$.frame') FROM study WHERE id = 1");
     const std::string frame = s.step() ? s.text(0) : "";
-    if (frame != "draped")
-      throw InputError("--ramp-ice: " + where + " was measured in the " +
-                       (frame.empty() ? std::string("default") : "'" + frame + "'") +
+    const std::string measured_in = (frame.empty() ? std::string("default") : "'" + frame + "'");
+    if (reading == CaseReading::ramp_ice && frame != "draped")
+      throw InputError(flag + ": " + where + " was measured in the " + measured_in +
                        " frame; the ramp's ice is read in the draped frame only (a study with "
                        "\"protocol\": \"initiation\" or \"measurement\": {\"frame\": \"draped\"})");
+    if (reading == CaseReading::clear_of_front && frame != "draped" && frame != "final")
+      throw InputError(flag + ": " + where + " was measured in the " + measured_in +
+                       " frame; allowed: the 'draped' and 'final' frames, whose windows end at the "
+                       "ice front");
   }
   Statement window(db,
-                   "SELECT m.window_min_x_m, json_extract(c.scene_json, '$.bed.step_length') "
+                   "SELECT m.window_min_x_m, m.window_max_x_m, "
+                   "json_extract(c.scene_json, '$.bed.step_length') "
                    "FROM summaries m JOIN cases c USING (case_id) WHERE case_id = ?");
   Statement cracks(
       db, "SELECT x_m, depth_m, spacing_to_next_m FROM crevasses WHERE case_id = ? ORDER BY x_m");
@@ -82,11 +113,15 @@ void read_ramp_ice(Store& store, const std::string& where, std::vector<CaseRecor
     if (!r.has_summary) continue;
     window.reset();
     window.bind(1, r.case_id);
-    if (!window.step() || window.is_null(1) || !(window.real(1) > 0.0))
-      throw InputError("--ramp-ice: " + where + ": case " + r.label +
-                       " has no ramp (bed.step_length absent or 0: a vertical step); allowed: "
-                       "studies whose every step has a ramp");
-    const double end = window.real(0) + window.real(1);
+    if (!window.step()) continue;
+    double end = window.real(1) - r.thickness_m();
+    if (reading == CaseReading::ramp_ice) {
+      if (window.is_null(2) || !(window.real(2) > 0.0))
+        throw InputError(flag + ": " + where + ": case " + r.label +
+                         " has no ramp (bed.step_length absent or 0: a vertical step); allowed: "
+                         "studies whose every step has a ramp");
+      end = window.real(0) + window.real(2);
+    }
     std::vector<double> depths, spacings;
     std::optional<double> spacing_before;  // the previous crevasse's spacing to this one
     cracks.reset();
@@ -182,7 +217,7 @@ std::vector<CaseRecord> read_case_records(Store& store, CaseReading reading) {
     out.push_back(std::move(r));
   }
   if (out.empty()) throw InputError(where + ": the study has no cases");
-  if (reading == CaseReading::ramp_ice) read_ramp_ice(store, where, out);
+  if (reading != CaseReading::window) read_part_of_window(store, where, reading, out);
   return out;
 }
 

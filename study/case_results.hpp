@@ -40,15 +40,20 @@ inline constexpr Quantity kQuantities[] = {Quantity::spacing, Quantity::depth};
 const char* quantity_key(Quantity q);     // "spacing_over_h", "depth_over_h" (fits table)
 const char* quantity_symbol(Quantity q);  // "L_p/H_i", "D_p/H_i"
 
-// Which crevasses of each case are read (docs/measurement.md, "The ramp's ice").
+// Which crevasses of each case are read (docs/measurement.md, "The ramp's ice", "Clear of the front").
 enum class CaseReading {
-  window,    // the measurement's whole window: the stored summary
-  ramp_ice,  // draped frame: the window's first L_s, the ice that lay over the ramp at the start
+  window,          // the measurement's whole window: the stored summary
+  ramp_ice,        // draped frame: the window's first L_s, the ice that lay over the ramp at the start
+  clear_of_front,  // draped or final frame: the window but its last H_i, next to the outflow's face
 };
+// What the reading's fits keys and figure files start with: "", "ramp_ice_", "clear_of_front_".
+const char* reading_prefix(CaseReading reading);
 // The fits table's key of `q` read so: "spacing_over_h", "ramp_ice_spacing_over_h", ...
 std::string fit_quantity_key(Quantity q, CaseReading reading);
-// "" or " (ramp ice)": what a table or figure adds to its title.
+// "", " (ramp ice)" or " (clear of the front)": what a table or figure adds to its title.
 const char* reading_label(CaseReading reading);
+// The command-line flag that selects it: "", "--ramp-ice" or "--clear-of-front".
+const char* reading_flag(CaseReading reading);
 
 struct CaseRecord {
   std::string case_id;
@@ -85,8 +90,8 @@ struct CaseRecord {
 };
 
 // Every case of the database, by case_index. Throws InputError when the database holds no
-// study or no cases, and for CaseReading::ramp_ice when the study was not measured in the draped
-// frame.
+// study or no cases, and for a reading the study's frame does not allow (ramp_ice: draped only;
+// clear_of_front: draped or final, the windows that end at the front).
 std::vector<CaseRecord> read_case_records(Store& store, CaseReading reading = CaseReading::window);
 
 // The study's name, or `fallback` when the database holds no study.

@@ -393,6 +393,15 @@ TEST(FitCli, StatusGivesTheShareOfCrevassesDeeperThanHalfTheIce) {
   EXPECT_EQ(share["1"], "100%") << status.out;
 }
 
+// Case i's spacing L_p = 0.3 (1 + 0.02 i) H_i, its depth 0.2 (Π/0.2)^0.5 H_i; a draped-frame study.
+FakeResult stretched(const StudyCase& c) {
+  FakeResult f;
+  f.spacing_over_h = 0.3 * (1.0 + 0.02 * static_cast<double>(c.index));
+  f.depth_over_h = 0.2 * std::sqrt(c.groups.cohesion_ratio / 0.2);
+  return f;
+}
+void draped(nlohmann::json& j) { j["measurement"] = {{"frame", "draped"}}; }
+
 // --ramp-ice reads each case's crevasses in the draped window's first L_s (the ice that lay over
 // the ramp at the start), fits and stores them beside the window's own fits, and draws and
 // calibrates from them; a study measured in another frame is refused.
@@ -402,15 +411,7 @@ TEST(FitCli, RampIceReadsTheDrapedWindowsFirstStepLengthBesideTheWindow) {
   // window's start at x = 1000 m, stretched by 1 + 0.02 i (L_p = 0.3 (1 + 0.02 i) H_i over the
   // window), so the first four, with three spacings, lie within its first L_s in every case; read
   // from x = 0 none would, read from the window's end all seven.
-  const auto stretched = [](const StudyCase& c) {
-    FakeResult f;
-    f.spacing_over_h = 0.3 * (1.0 + 0.02 * static_cast<double>(c.index));
-    f.depth_over_h = 0.2 * std::sqrt(c.groups.cohesion_ratio / 0.2);
-    return f;
-  };
-  write_synthetic_db(
-      dir / "d.db", 6, {100.0}, stretched,
-      [](nlohmann::json& j) { j["measurement"] = {{"frame", "draped"}}; }, 1000.0);
+  write_synthetic_db(dir / "d.db", 6, {100.0}, stretched, draped, 1000.0);
   {
     Store store = Store::open_reader(dir / "d.db");
     const std::vector<CaseRecord> window = read_case_records(store);
@@ -465,12 +466,68 @@ TEST(FitCli, RampIceReadsTheDrapedWindowsFirstStepLengthBesideTheWindow) {
             "0");
   // A vertical step has no ramp: refused, not read as "no crevasse" everywhere.
   write_synthetic_db(dir / "v.db", 6, {100.0}, stretched, [](nlohmann::json& j) {
-    j["measurement"] = {{"frame", "draped"}};
+    draped(j);
     j["fixed"] = {{"step_length_ratio", 0.0}, {"step_height_ratio", 1.0}};
   });
   const test::CliResult vertical = test::run_cli(dir.path(), "fit v.db --ramp-ice");
   expect_one_line_error(vertical, "--ramp-ice");
   EXPECT_NE(vertical.err.find("vertical step"), std::string::npos) << vertical.err;
+}
+
+// --clear-of-front reads each case's window but its last H_i, where the outflow's free face
+// breaks the ice (docs/measurement.md, "Clear of the front"), and keeps its fits and figures
+// beside the window's; a frame whose window does not end at the front is refused.
+TEST(FitCli, ClearOfFrontReadsTheWindowButItsLastThickness) {
+  test::ScratchDir dir("fit");
+  // H_i = 100 m; case i's 7 crevasses stand at 0, 0.8, 1.7, 2.65, 3.65, 4.7 and 5.8 l past x = 1000 m,
+  // l = 30 (1 + 0.02 i) m, and the window ends at the last one. Case 0 (l = 30 m): the window's
+  // last H_i begins at 74 m, so 3 crevasses are read (2 spacings, 24 and 27 m); case 5
+  // (l = 33 m): it begins at 91.4 m, 4 crevasses (26.4, 29.7, 31.35 m). Reading the window's
+  // first H_i would give 4 in case 0, and dropping only its last H_i/2 5.
+  write_synthetic_db(dir / "d.db", 6, {100.0}, stretched, draped, 1000.0);
+  {
+    Store store = Store::open_reader(dir / "d.db");
+    const std::vector<CaseRecord> clear = read_case_records(store, CaseReading::clear_of_front);
+    ASSERT_EQ(clear.size(), 6u);
+    EXPECT_EQ(clear[0].crevasse_count, 3);
+    EXPECT_EQ(clear[0].spacing_count, 2);
+    EXPECT_NEAR(clear[0].spacing_over_h[1].value_or(0.0), 0.255, 1e-12);
+    EXPECT_EQ(clear[5].crevasse_count, 4);
+    EXPECT_EQ(clear[5].spacing_count, 3);
+    EXPECT_NEAR(clear[5].spacing_over_h[1].value_or(0.0), 0.297, 1e-12);
+    EXPECT_NEAR(clear[5].spacings_m.back(), 31.35, 1e-9);
+  }
+  ASSERT_EQ(test::run_cli(dir.path(), "fit d.db").code, 0);
+  const test::CliResult fit = test::run_cli(dir.path(), "fit d.db --clear-of-front");
+  ASSERT_EQ(fit.code, 0) << fit.err;
+  EXPECT_NE(fit.out.find("(clear of the front)"), std::string::npos) << fit.out;
+  EXPECT_EQ(test::dump_rows(dir / "d.db",
+                            "SELECT quantity || ' ' || round(y_min, 4) FROM fits "
+                            "WHERE model = 'single' AND quantity LIKE '%spacing%' ORDER BY quantity"),
+            (std::vector<std::string>{"clear_of_front_spacing_over_h 0.255",
+                                      "spacing_over_h 0.3"}));
+  const test::CliResult plot = test::run_cli(dir.path(), "plot d.db --out figs --clear-of-front");
+  ASSERT_EQ(plot.code, 0) << plot.err;
+  EXPECT_NE(test::read_file(dir / "figs" / "clear_of_front_spacing_vs_cohesion_ratio.svg")
+                .find("clear of the front"),
+            std::string::npos);
+  const test::CliResult predict = test::run_cli(
+      dir.path(), "predict --db d.db --cohesion 100000 --thickness 100 --clear-of-front");
+  ASSERT_EQ(predict.code, 0) << predict.err;
+  EXPECT_NE(predict.out.find("crevasse fit --clear-of-front"), std::string::npos) << predict.out;
+  // One reading at a time.
+  const test::CliResult both = test::run_cli(dir.path(), "fit d.db --ramp-ice --clear-of-front");
+  EXPECT_EQ(both.code, 2) << both.out << both.err;
+  EXPECT_NE(both.err.find("excludes"), std::string::npos) << both.err;
+
+  // Measured in the default frame: refused, one line, nothing stored.
+  write_synthetic_db(dir / "w.db", 6, {100.0}, stretched);
+  const test::CliResult refused = test::run_cli(dir.path(), "fit w.db --clear-of-front");
+  expect_one_line_error(refused, "--clear-of-front");
+  EXPECT_NE(refused.err.find("'draped' and 'final'"), std::string::npos) << refused.err;
+  EXPECT_EQ(test::dump_rows(dir / "w.db", "SELECT count(*) FROM sqlite_master WHERE name = 'fits'")
+                .at(0),
+            "0");
 }
 
 // --add-cases draws another study's cases on the diagram under their study's name and field
