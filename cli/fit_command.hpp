@@ -3,9 +3,9 @@
 // power law and a broken line (docs/fits.md), prints the table and stores it in the database's
 // `fits` table (docs/database.md).
 #include <string>
+#include <vector>
 
 #include "study/case_results.hpp"
-#include <vector>
 
 namespace crevasse {
 

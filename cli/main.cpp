@@ -28,8 +28,6 @@
 
 namespace {
 
-// A message as one printable line of bounded length: it may echo user input (a key, a value), and
-// neither a terminal escape nor a megabyte of a bad value belongs on the user's terminal.
 // --ramp-ice and --clear-of-front, one or neither: which crevasses of each case are read
 // (docs/measurement.md, "The ramp's ice", "Clear of the front").
 void add_reading_flags(CLI::App* command, crevasse::CaseReading& reading, const std::string& ramp_help,
@@ -42,6 +40,8 @@ void add_reading_flags(CLI::App* command, crevasse::CaseReading& reading, const 
   ramp->excludes(front);
 }
 
+// A message as one printable line of bounded length: it may echo user input (a key, a value), and
+// neither a terminal escape nor a megabyte of a bad value belongs on the user's terminal.
 std::string one_line(const std::string& what) {
   constexpr std::size_t kMaxMessage = 600;
   std::string s;

@@ -5,9 +5,9 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "study/case_results.hpp"
-#include <vector>
 
 namespace crevasse {
 

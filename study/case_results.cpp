@@ -26,35 +26,30 @@ const char* quantity_key(Quantity q) {
 }
 const char* quantity_symbol(Quantity q) { return q == Quantity::spacing ? "L_p/H_i" : "D_p/H_i"; }
 
-const char* reading_prefix(CaseReading reading) {
-  switch (reading) {
-    case CaseReading::ramp_ice: return "ramp_ice_";
-    case CaseReading::clear_of_front: return "clear_of_front_";
-    case CaseReading::window: break;
-  }
-  return "";
+namespace {
+// Each reading's names, in the order of CaseReading: key and file prefix, title label, flag.
+struct ReadingNames {
+  const char* prefix;
+  const char* label;
+  const char* flag;
+};
+constexpr ReadingNames kReadingNames[] = {
+    {"", "", ""},
+    {"ramp_ice_", " (ramp ice)", "--ramp-ice"},
+    {"clear_of_front_", " (clear of the front)", "--clear-of-front"},
+};
+static_assert(std::size(kReadingNames) == static_cast<std::size_t>(CaseReading::clear_of_front) + 1);
+const ReadingNames& names(CaseReading reading) {
+  return kReadingNames[static_cast<std::size_t>(reading)];
 }
+}  // namespace
+
+const char* reading_prefix(CaseReading reading) { return names(reading).prefix; }
+const char* reading_label(CaseReading reading) { return names(reading).label; }
+const char* reading_flag(CaseReading reading) { return names(reading).flag; }
 
 std::string fit_quantity_key(Quantity q, CaseReading reading) {
   return reading_prefix(reading) + std::string(quantity_key(q));
-}
-
-const char* reading_label(CaseReading reading) {
-  switch (reading) {
-    case CaseReading::ramp_ice: return " (ramp ice)";
-    case CaseReading::clear_of_front: return " (clear of the front)";
-    case CaseReading::window: break;
-  }
-  return "";
-}
-
-const char* reading_flag(CaseReading reading) {
-  switch (reading) {
-    case CaseReading::ramp_ice: return "--ramp-ice";
-    case CaseReading::clear_of_front: return "--clear-of-front";
-    case CaseReading::window: break;
-  }
-  return "";
 }
 
 std::optional<double> CaseRecord::group(const FitGroup& g) const {
@@ -113,15 +108,14 @@ void read_part_of_window(Store& store, const std::string& where, CaseReading rea
     if (!r.has_summary) continue;
     window.reset();
     window.bind(1, r.case_id);
-    if (!window.step()) continue;
-    double end = window.real(1) - r.thickness_m();
-    if (reading == CaseReading::ramp_ice) {
-      if (window.is_null(2) || !(window.real(2) > 0.0))
-        throw InputError(flag + ": " + where + ": case " + r.label +
-                         " has no ramp (bed.step_length absent or 0: a vertical step); allowed: "
-                         "studies whose every step has a ramp");
-      end = window.real(0) + window.real(2);
-    }
+    if (!window.step()) continue;  // has_summary: the row is there
+    const bool no_ramp = window.is_null(2) || !(window.real(2) > 0.0);
+    if (reading == CaseReading::ramp_ice && no_ramp)
+      throw InputError(flag + ": " + where + ": case " + r.label +
+                       " has no ramp (bed.step_length absent or 0: a vertical step); allowed: "
+                       "studies whose every step has a ramp");
+    const double end = reading == CaseReading::ramp_ice ? window.real(0) + window.real(2)
+                                                        : window.real(1) - r.thickness_m();
     std::vector<double> depths, spacings;
     std::optional<double> spacing_before;  // the previous crevasse's spacing to this one
     cracks.reset();

@@ -480,22 +480,24 @@ TEST(FitCli, RampIceReadsTheDrapedWindowsFirstStepLengthBesideTheWindow) {
 TEST(FitCli, ClearOfFrontReadsTheWindowButItsLastThickness) {
   test::ScratchDir dir("fit");
   // H_i = 100 m; case i's 7 crevasses stand at 0, 0.8, 1.7, 2.65, 3.65, 4.7 and 5.8 l past x = 1000 m,
-  // l = 30 (1 + 0.02 i) m, and the window ends at the last one. Case 0 (l = 30 m): the window's
-  // last H_i begins at 74 m, so 3 crevasses are read (2 spacings, 24 and 27 m); case 5
-  // (l = 33 m): it begins at 91.4 m, 4 crevasses (26.4, 29.7, 31.35 m). Reading the window's
-  // first H_i would give 4 in case 0, and dropping only its last H_i/2 5.
+  // l = 30 (1 + 0.02 i) m, and the window ends 40 m past the last one. Case 0 (l = 30 m): the
+  // window's last H_i begins at 114 m, so 5 crevasses are read (4 spacings, 24, 27, 28.5 and
+  // 30 m); case 5 (l = 33 m): it begins at 131.4 m, 5 crevasses (26.4, 29.7, 31.35, 33 m). Read
+  // from the last crevasse instead of the window's end, case 0 would give 3; the window's first
+  // H_i 4; dropping only its last H_i/2 6.
   write_synthetic_db(dir / "d.db", 6, {100.0}, stretched, draped, 1000.0);
+  Store::open_writer(dir / "d.db").exec("UPDATE summaries SET window_max_x_m = window_max_x_m + 40");
   {
     Store store = Store::open_reader(dir / "d.db");
     const std::vector<CaseRecord> clear = read_case_records(store, CaseReading::clear_of_front);
     ASSERT_EQ(clear.size(), 6u);
-    EXPECT_EQ(clear[0].crevasse_count, 3);
-    EXPECT_EQ(clear[0].spacing_count, 2);
-    EXPECT_NEAR(clear[0].spacing_over_h[1].value_or(0.0), 0.255, 1e-12);
-    EXPECT_EQ(clear[5].crevasse_count, 4);
-    EXPECT_EQ(clear[5].spacing_count, 3);
-    EXPECT_NEAR(clear[5].spacing_over_h[1].value_or(0.0), 0.297, 1e-12);
-    EXPECT_NEAR(clear[5].spacings_m.back(), 31.35, 1e-9);
+    EXPECT_EQ(clear[0].crevasse_count, 5);
+    EXPECT_EQ(clear[0].spacing_count, 4);
+    EXPECT_NEAR(clear[0].spacing_over_h[1].value_or(0.0), 0.2775, 1e-12);
+    EXPECT_EQ(clear[5].crevasse_count, 5);
+    EXPECT_EQ(clear[5].spacing_count, 4);
+    EXPECT_NEAR(clear[5].spacing_over_h[1].value_or(0.0), 0.30525, 1e-12);
+    EXPECT_NEAR(clear[5].spacings_m.back(), 33.0, 1e-9);
   }
   ASSERT_EQ(test::run_cli(dir.path(), "fit d.db").code, 0);
   const test::CliResult fit = test::run_cli(dir.path(), "fit d.db --clear-of-front");
@@ -504,7 +506,7 @@ TEST(FitCli, ClearOfFrontReadsTheWindowButItsLastThickness) {
   EXPECT_EQ(test::dump_rows(dir / "d.db",
                             "SELECT quantity || ' ' || round(y_min, 4) FROM fits "
                             "WHERE model = 'single' AND quantity LIKE '%spacing%' ORDER BY quantity"),
-            (std::vector<std::string>{"clear_of_front_spacing_over_h 0.255",
+            (std::vector<std::string>{"clear_of_front_spacing_over_h 0.2775",
                                       "spacing_over_h 0.3"}));
   const test::CliResult plot = test::run_cli(dir.path(), "plot d.db --out figs --clear-of-front");
   ASSERT_EQ(plot.code, 0) << plot.err;
