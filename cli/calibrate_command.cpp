@@ -103,7 +103,7 @@ StudyLaws load_laws(const std::string& db_path, CaseReading reading) {
   Store store = Store::open_reader(db_path);
   const std::vector<CaseRecord> cases = read_case_records(store, reading);
   StudyLaws laws;
-  laws.title = study_title(store) + reading_label(reading);
+  laws.title = study_title(store, reading);
   const FitGroup& pi = find_fit_group("cohesion_ratio", "group");
   std::vector<FitRecord> spacing =
       read_fit_records(store, fit_quantity_key(Quantity::spacing, reading), pi.name);

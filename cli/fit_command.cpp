@@ -110,7 +110,7 @@ int fit_command(const FitCommandOptions& opt) {
   {
     Store reader = Store::open_reader(opt.db_path);
     cases = read_case_records(reader, reading);
-    title = study_title(reader) + reading_label(reading);
+    title = study_title(reader, reading);
   }
   std::vector<const FitGroup*> groups;
   for (const std::string& name :

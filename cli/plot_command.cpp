@@ -121,7 +121,7 @@ std::vector<fs::path> plot_study(const PlotCommandOptions& opt) {
   Store store = Store::open_reader(opt.db_path);
   const CaseReading reading = opt.reading;
   const std::vector<CaseRecord> cases = read_case_records(store, reading);
-  const std::string own_name = study_name_with_field(store, "study") + reading_label(reading);
+  const std::string own_name = study_name_with_field(store, "study", reading);
   // Every reading's figures can share a folder.
   const std::string file_prefix = reading_prefix(reading);
   std::vector<const CaseRecord*> cdf_cases;

@@ -35,8 +35,8 @@ struct ReadingNames {
 };
 constexpr ReadingNames kReadingNames[] = {
     {"", "", ""},
-    {"ramp_ice_", " (ramp ice)", "--ramp-ice"},
-    {"clear_of_front_", " (clear of the front)", "--clear-of-front"},
+    {"ramp_ice_", "ramp ice", "--ramp-ice"},
+    {"clear_of_front_", "clear of the front", "--clear-of-front"},
 };
 static_assert(std::size(kReadingNames) == static_cast<std::size_t>(CaseReading::clear_of_front) + 1);
 const ReadingNames& names(CaseReading reading) {
@@ -220,7 +220,8 @@ std::string study_name(Store& store, const std::string& fallback) {
   return s.step() ? s.text(0) : fallback;
 }
 
-std::string study_field_label(Store& store) {
+namespace {
+std::string protocol_and_frame(Store& store) {
   Statement s(store.handle(), "SELECT file_text, measurement_json FROM study WHERE id = 1");
   if (!s.step()) return "";
   const auto file = nlohmann::json::parse(s.text(0), nullptr, false);
@@ -232,14 +233,22 @@ std::string study_field_label(Store& store) {
     return file.at("protocol").get<std::string>() + " protocol, " + frame + " frame";
   return frame.empty() ? "" : frame + " frame";
 }
+}  // namespace
 
-std::string study_name_with_field(Store& store, const std::string& fallback) {
-  const std::string label = study_field_label(store);
+std::string study_field_label(Store& store, CaseReading reading) {
+  const std::string field = protocol_and_frame(store);
+  const std::string read = reading_label(reading);
+  if (read.empty()) return field;
+  return field.empty() ? read : field + ", " + read;
+}
+
+std::string study_name_with_field(Store& store, const std::string& fallback, CaseReading reading) {
+  const std::string label = study_field_label(store, reading);
   return study_name(store, fallback) + (label.empty() ? std::string() : " (" + label + ")");
 }
 
-std::string study_title(Store& store) {
-  const std::string label = study_field_label(store);
+std::string study_title(Store& store, CaseReading reading) {
+  const std::string label = study_field_label(store, reading);
   return "study '" + study_name(store, "?") + "'" + (label.empty() ? "" : ", " + label) + " (" +
          store.path().string() + ")";
 }

@@ -50,7 +50,7 @@ enum class CaseReading {
 const char* reading_prefix(CaseReading reading);
 // The fits table's key of `q` read so: "spacing_over_h", "ramp_ice_spacing_over_h", ...
 std::string fit_quantity_key(Quantity q, CaseReading reading);
-// "", " (ramp ice)" or " (clear of the front)": what a table or figure adds to its title.
+// "", "ramp ice" or "clear of the front": what a table or figure adds to its field's label.
 const char* reading_label(CaseReading reading);
 // The command-line flag that selects it: "", "--ramp-ice" or "--clear-of-front".
 const char* reading_flag(CaseReading reading);
@@ -97,12 +97,14 @@ std::vector<CaseRecord> read_case_records(Store& store, CaseReading reading = Ca
 // The study's name, or `fallback` when the database holds no study.
 std::string study_name(Store& store, const std::string& fallback);
 // What a figure or fit says it shows: "initiation protocol, draped frame" (a study that names its
-// protocol), "passed frame" (one that does not), or "" (no study row).
-std::string study_field_label(Store& store);
+// protocol), "passed frame" (one that does not), or "" (no study row); a reading other than the
+// window's follows: "initiation protocol, draped frame, clear of the front".
+std::string study_field_label(Store& store, CaseReading reading = CaseReading::window);
 // The name with its field: "regime_steady (steady protocol, passed frame)", as figures label a study.
-std::string study_name_with_field(Store& store, const std::string& fallback);
+std::string study_name_with_field(Store& store, const std::string& fallback,
+                                  CaseReading reading = CaseReading::window);
 
-// "study 'quick' (results/quick.db)".
-std::string study_title(Store& store);
+// "study 'quick', initiation protocol, draped frame (results/quick.db)".
+std::string study_title(Store& store, CaseReading reading = CaseReading::window);
 
 }  // namespace crevasse

@@ -437,7 +437,8 @@ TEST(FitCli, RampIceReadsTheDrapedWindowsFirstStepLengthBesideTheWindow) {
   ASSERT_EQ(test::run_cli(dir.path(), "fit d.db").code, 0);
   const test::CliResult fit = test::run_cli(dir.path(), "fit d.db --ramp-ice");
   ASSERT_EQ(fit.code, 0) << fit.err;
-  EXPECT_NE(fit.out.find("(ramp ice)"), std::string::npos) << fit.out;
+  // The reading follows the study's field inside the title's one pair of parentheses.
+  EXPECT_NE(fit.out.find("draped frame, ramp ice ("), std::string::npos) << fit.out;
   // Each reading's rows under its own key; the ramp's medians span 0.27-0.297, the window's 0.3-0.33.
   EXPECT_EQ(test::dump_rows(dir / "d.db",
                             "SELECT quantity || ' ' || round(y_min, 4) || ' ' || round(y_max, 4) "
@@ -502,7 +503,7 @@ TEST(FitCli, ClearOfFrontReadsTheWindowButItsLastThickness) {
   ASSERT_EQ(test::run_cli(dir.path(), "fit d.db").code, 0);
   const test::CliResult fit = test::run_cli(dir.path(), "fit d.db --clear-of-front");
   ASSERT_EQ(fit.code, 0) << fit.err;
-  EXPECT_NE(fit.out.find("(clear of the front)"), std::string::npos) << fit.out;
+  EXPECT_NE(fit.out.find("draped frame, clear of the front ("), std::string::npos) << fit.out;
   EXPECT_EQ(test::dump_rows(dir / "d.db",
                             "SELECT quantity || ' ' || round(y_min, 4) FROM fits "
                             "WHERE model = 'single' AND quantity LIKE '%spacing%' ORDER BY quantity"),
