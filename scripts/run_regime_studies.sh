@@ -6,7 +6,7 @@
 #   nohup bash scripts/run_regime_studies.sh > regime.log 2>&1 &
 #
 # The cheap cases go first, so that the initiation study covers H_i = 200-600 m with its replicas
-# and the step's shape before the long steady row at 800 m (about 80 min per case on both cores):
+# and the step's shape before the long steady row at 800 m (about 2 h per case on both cores):
 # 1. the replicas, and the geometry study's cases at S = 1/2, L_s = H_i measured from the steady
 #    runs' particles at 2 H_i (the cases a run would store, without the field over time:
 #    docs/model.md, "Two protocols"), then its cases that vary one of S and L_s/H_i at a time.
@@ -15,17 +15,20 @@
 # 2. the initiation study's cases the steady study does not serve (H_i = 200, 600 m, and
 #    Π = 0.0375, 0.125 at 800 m); fits, figures and the field calibration;
 # 3. the steady study, which keeps each case's particles at 1.25, 2 and 3 H_i through the gate, and
-#    after each of its cases the initiation case measured from them; fits, figures, calibration again;
+#    the initiation cases measured from those at 2 H_i; fits, figures, calibration again;
 # 4. the rest of the geometry study (S and L_s/H_i together), then its fits and figures.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cmake --build build -j "$(nproc)" --target crevasse
 C=./build/cli/crevasse
 R=results
-# The cases still to run go one at a time on both cores (the same results bit for bit as one thread each,
-# docs/performance.md, "Bit identity"): a case finishes in half the wall time, so an interruption loses at most
-# one case's progress since its last checkpoint, and a sitting of a few hours finishes whole cases.
+# One and two engine threads give the same results bit for bit (docs/performance.md, "Bit identity").
+# The 600 m and 800 m initiation cases ran one at a time on both cores, so that a sitting of a few hours
+# finished whole cases; what is left runs two cases at once on one thread each, which makes about a
+# tenth more particle-steps per second (docs/performance.md, "Open targets"), and each case resumes from
+# its own checkpoint after an interruption.
 ONE_CASE_AT_A_TIME="--jobs 1 --threads-per-case 2"
+TWO_CASES_AT_ONCE="--jobs 2 --threads-per-case 1"
 
 # Arguments: the steady study's cases whose CDFs are drawn (only cases that are done).
 fit_and_plot() {
@@ -72,21 +75,32 @@ $C study studies/regime_initiation.json --db $R/regime_initiation.db --cases 0-1
   --views $R/regime_initiation_views $ONE_CASE_AT_A_TIME
 fit_and_plot 1 2 4
 
-# The steady study one case at a time, each followed by the initiation case it serves (the same Π
-# and H_i, measured from its particles at 2 H_i through the gate), so that a case's kept particles
-# are used in the sitting that made them. Steady cases 0-7 (400 m) serve initiation cases 11-13,
-# 15-19; 8-15 (800 m) serve 31-33, 35-39 (`--dry-run` lists both studies).
+# The steady study, two cases at once. Each steady case serves the initiation case of the same Π
+# and H_i, measured from its particles kept at 2 H_i through the gate: steady cases 0-7 (400 m)
+# serve initiation cases 11-13, 15-19; 8-15 (800 m) serve 31-33, 35-39 (`--dry-run` lists both
+# studies). Those whose particles are kept are measured before the steady study runs on, and after.
 SERVED=(11 12 13 15 16 17 18 19 31 32 33 35 36 37 38 39)
-for i in "${!SERVED[@]}"; do
-  $C study studies/regime_steady.json --db $R/regime_steady.db --cases "$i" --keep-particles \
-    --views $R/regime_steady_views $ONE_CASE_AT_A_TIME
-  $C study studies/regime_initiation.json --db $R/regime_initiation.db --cases "${SERVED[$i]}" \
+measure_served() {
+  local cases=()
+  for i in "${!SERVED[@]}"; do
+    if [ -f "$(printf '%s/regime_steady.db.particles/case_%03d_gate_2_particles.bin' $R "$i")" ]; then
+      cases+=("${SERVED[$i]}")
+    fi
+  done
+  if [ ${#cases[@]} -eq 0 ]; then return 0; fi
+  $C study studies/regime_initiation.json --db $R/regime_initiation.db --cases "$(IFS=,; echo "${cases[*]}")" \
     --remeasure $R/regime_steady.db --particles-from $R/regime_steady.db.particles --views $R/regime_initiation_views
-done
+}
+measure_served
+steady_status=0
+$C study studies/regime_steady.json --db $R/regime_steady.db --keep-particles \
+  --views $R/regime_steady_views $TWO_CASES_AT_ONCE || steady_status=$?
+measure_served
+[ "$steady_status" -eq 0 ] || exit "$steady_status"
 fit_and_plot 1 2 4 12
 
 # The rest of the geometry study, S and L_s/H_i together; then its fits and figures.
 $C study studies/regime_initiation_geometry.json --db $R/regime_initiation_geometry.db --keep-particles \
-  --views $R/regime_initiation_geometry_views $ONE_CASE_AT_A_TIME
+  --views $R/regime_initiation_geometry_views $TWO_CASES_AT_ONCE
 $C fit $R/regime_initiation_geometry.db
 $C plot $R/regime_initiation_geometry.db --out $R/regime_initiation_geometry_figures --cdf-normalise bending
