@@ -126,8 +126,11 @@ int run_command_line(int argc, char** argv) {
 
   crevasse::StatusCommandOptions status_opt;
   auto* status = app.add_subcommand("status", "Summarise a study database (safe while the study runs)");
-  status->add_option("db", status_opt.db_path, "Study database")->required();
+  status->add_option("db", status_opt.db_paths, "Study database (several with --compute)")->required();
   status->add_flag("--all", status_opt.all_cases, "List every finished case");
+  status->add_flag("--compute", status_opt.compute_table,
+                   "Only the compute the databases hold, per H_i, as a Markdown table: cases run, cases served "
+                   "by another case's kept particles, particle-steps, engine wall time");
 
   crevasse::ExportCommandOptions export_opt;
   auto* export_cmd = app.add_subcommand("export", "Write a study database as CSV files, one per table");

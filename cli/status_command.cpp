@@ -1,27 +1,62 @@
 #include "cli/status_command.hpp"
 
 #include <cstdio>
+#include <filesystem>
 #include <string>
 
 #include "cli/progress_printer.hpp"
+#include "engine/error.hpp"
 #include "study/store.hpp"
+#include "study/study_compute.hpp"
 
 namespace crevasse {
 namespace {
 
 constexpr long long kDefaultCaseRows = 60;
 
-std::string cell(const Statement& s, int c, const char* format) {
-  if (s.is_null(c)) return "-";
+std::string cell_value(double v, const char* format) {
   char buf[64];
-  std::snprintf(buf, sizeof buf, format, s.real(c));
+  std::snprintf(buf, sizeof buf, format, v);
   return buf;
+}
+
+std::string cell(const Statement& s, int c, const char* format) {
+  return s.is_null(c) ? "-" : cell_value(s.real(c), format);
+}
+
+void print_compute_row(const std::string& name, const ComputeRow& r, bool total) {
+  std::printf("| %s | %s | %lld | %lld | %lld | %.1f | %.2f | %s |\n", name.c_str(),
+              total ? "" : std::to_string(static_cast<long long>(r.thickness_m)).c_str(), r.run,
+              r.served, r.pending, r.particle_steps / 1e9, r.wall_s / 3600.0,
+              r.median_rate > 0 ? cell_value(r.median_rate / 1e6, "%.1f").c_str() : "-");
+}
+
+int compute_table(const std::vector<std::string>& paths) {
+  std::printf(
+      "| database | H_i [m] | cases run | served by another case's run | not finished | "
+      "particle-steps [1e9] | case wall time [h] | M particle-steps/s per case (median) |\n"
+      "|---|---|---|---|---|---|---|---|\n");
+  std::vector<ComputeRow> all;
+  for (const std::string& path : paths) {
+    Store store = Store::open_reader(path);
+    const std::string name = std::filesystem::path(path).filename().string();
+    for (const ComputeRow& r : study_compute(store)) {
+      print_compute_row(name, r, false);
+      all.push_back(r);
+    }
+  }
+  if (paths.size() > 1) print_compute_row("all", compute_total(all), true);
+  return 0;
 }
 
 }  // namespace
 
 int status_command(const StatusCommandOptions& opt) {
-  Store store = Store::open_reader(opt.db_path);
+  if (opt.compute_table) return compute_table(opt.db_paths);
+  if (opt.db_paths.size() != 1)
+    throw InputError("status: give one database (several only with --compute)");
+  const std::string& db_path = opt.db_paths.front();
+  Store store = Store::open_reader(db_path);
   sqlite3* db = store.handle();
   {
     Statement s(db,
@@ -29,28 +64,34 @@ int status_command(const StatusCommandOptions& opt) {
                 "'-'), description "
                 "FROM study WHERE id = 1");
     if (!s.step()) {
-      std::printf("%s: no study recorded yet\n", opt.db_path.c_str());
+      std::printf("%s: no study recorded yet\n", db_path.c_str());
       return 0;
     }
     std::printf("study %s: %lld cases, engine %s, database %s\n", s.text(0).c_str(),
-                static_cast<long long>(s.integer(1)), s.text(2).c_str(), opt.db_path.c_str());
+                static_cast<long long>(s.integer(1)), s.text(2).c_str(), db_path.c_str());
     if (!s.text(6).empty()) std::printf("  %s\n", s.text(6).c_str());
     std::printf("  created %s on %s, last session ended %s\n", s.text(4).c_str(), s.text(3).c_str(),
                 s.text(5).c_str());
   }
   const StatusCounts c = store.counts();
   {
-    Statement s(db,
-                "SELECT coalesce(sum(wall_s), 0), coalesce(sum(particle_steps), 0) FROM cases "
-                "WHERE status IN ('done', 'failed')");
-    s.step();
+    const std::vector<ComputeRow> rows = study_compute(store);
+    const ComputeRow t = compute_total(rows);
     std::printf(
-        "  in this database: %lld done, %lld failed, %lld running, %lld pending (of %lld); %s of "
-        "case "
-        "wall time, %.3g particle-steps\n",
+        "  in this database: %lld done, %lld failed, %lld running, %lld pending (of %lld)\n"
+        "  compute: %lld cases run, %s of case wall time, %.3g particle-steps",
         static_cast<long long>(c.done), static_cast<long long>(c.failed),
         static_cast<long long>(c.running), static_cast<long long>(c.pending),
-        static_cast<long long>(c.total()), format_duration(s.real(0)).c_str(), s.real(1));
+        static_cast<long long>(c.total()), t.run, format_duration(t.wall_s).c_str(),
+        t.particle_steps);
+    if (t.served > 0)
+      std::printf("; %lld served by another case's run (counted where it ran)", t.served);
+    std::printf("\n");
+    if (rows.size() > 1)
+      for (const ComputeRow& r : rows)
+        std::printf("    H_i = %.0f m: %lld run, %lld served, %s, %.3g particle-steps\n",
+                    r.thickness_m, r.run, r.served, format_duration(r.wall_s).c_str(),
+                    r.particle_steps);
   }
   {
     Statement s(db, "SELECT count(*), coalesce(sum(outcome IS NULL), 0) FROM sessions");

@@ -174,6 +174,14 @@ TEST(Cli, StudyStatusExportAndSqlite3) {
   EXPECT_NE(status.out.find("3 done, 0 failed, 0 running, 0 pending"), std::string::npos)
       << status.out;
   EXPECT_NE(status.out.find("cohesion_ratio=0.05"), std::string::npos) << status.out;
+  EXPECT_NE(status.out.find("compute: 3 cases run"), std::string::npos) << status.out;
+  const Result compute = run_cli(dir.path(), "status --compute results/cli.db results/cli.db");
+  EXPECT_EQ(compute.code, 0) << compute.err;
+  EXPECT_NE(compute.out.find("| cli.db | 40 | 3 | 0 | 0 |"), std::string::npos) << compute.out;
+  EXPECT_NE(compute.out.find("| all |  | 6 | 0 | 0 |"), std::string::npos) << compute.out;
+  const Result two = run_cli(dir.path(), "status results/cli.db results/cli.db");
+  EXPECT_EQ(two.code, 2);
+  EXPECT_NE(two.err.find("several only with --compute"), std::string::npos) << two.err;
 
   const Result exp = run_cli(dir.path(), "export results/cli.db --csv csv");
   EXPECT_EQ(exp.code, 0) << exp.err;
