@@ -8,6 +8,9 @@ one markdown row per case for every c reached at two or more thicknesses (--ever
 
     python3 scripts/fixed_cohesion_table.py results/regime_initiation.db [results/regime_initiation_replicas.db ...]
 
+With --by-pi the same cases are grouped by Pi instead, with spacing and depth over H_i: the
+dependence on H_i at fixed Pi (a law in Pi alone carries the same L_p/H_i and D_p/H_i at every H_i).
+
 Only the reference step (slope 1/2, L_s = H_i) is kept unless --all-steps is given. The last
 column reads the crevasse table of the window's first LEAD·L_s (--lead, default 1; L_s the step's
 horizontal length): in the draped frame that is the ice that lay on the ramp at the start (the
@@ -64,7 +67,9 @@ def main():
     parser.add_argument("--lead", type=float, default=1.0,
                         help="length of the window's leading part, in L_s (default 1)")
     parser.add_argument("--every-c", action="store_true",
-                        help="also list the values of c reached at one thickness only")
+                        help="also list the values of c (or Pi) reached at one thickness only")
+    parser.add_argument("--by-pi", action="store_true",
+                        help="group by Pi, spacing and depth over H_i: the dependence on H_i at fixed Pi")
     args = parser.parse_args()
 
     every = []
@@ -74,6 +79,9 @@ def main():
         except sqlite3.Error as error:
             sys.exit(f"error: {db}: {error}")
 
+    if args.by_pi:
+        by_pi(every, args.every_c)
+        return
     groups = {}
     for case in every:
         groups.setdefault(round(case["c"] / 1000.0), []).append(case)
@@ -95,6 +103,29 @@ def main():
                   f"| {k['index']} ({k['seed']}) | {k['count']} | {spacing} | {fmt(k['d_med'])} "
                   f"| {fmt(None if k['d_med'] is None else k['d_med'] / length, 1)} | {fmt(ratio, 2)} "
                   f"| {k['lead_count']}, {fmt(k['lead_l'])}, {fmt(k['lead_d'])} |")
+
+
+def over_h(value, h, digits=3):
+    return fmt(None if value is None else value / h, digits)
+
+
+def by_pi(every, every_pi):
+    groups = {}
+    for case in every:
+        groups.setdefault(round(case["pi"], 6), []).append(case)
+    print("| Π | H_i [m] | c [kPa] | case (seed) | count | L_p/H_i | D_p/H_i "
+          "| window's first LEAD·L_s: count, L_p/H_i, D_p/H_i |")
+    print("|---|---|---|---|---|---|---|---|")
+    for pi in sorted(groups):
+        group = sorted(groups[pi], key=lambda k: (k["h"], k["seed"]))
+        if len({k["h"] for k in group}) < 2 and not every_pi:
+            continue
+        for k in group:
+            h = k["h"]
+            print(f"| {pi:g}{' (under-resolved)' if k['under'] else ''} | {h:.0f} | {k['c'] / 1000:.0f} "
+                  f"| {k['index']} ({k['seed']}) | {k['count']} | {over_h(k['l_med'], h)} "
+                  f"| {over_h(k['d_med'], h)} | {k['lead_count']}, {over_h(k['lead_l'], h)}, "
+                  f"{over_h(k['lead_d'], h)} |")
 
 
 if __name__ == "__main__":
