@@ -5,6 +5,9 @@
 #
 #   nohup bash scripts/run_regime_studies.sh > regime.log 2>&1 &
 #
+# `bash scripts/run_regime_studies.sh --fits-only` redraws the fits, figures and calibrations from
+# what the databases hold, running nothing (after cases were measured by hand, say).
+#
 # The cheap cases go first, so that the initiation study covers H_i = 200-600 m with its replicas
 # and the step's shape before the long steady row at 800 m (about 2 h per case on both cores):
 # 1. the replicas, and the geometry study's cases at S = 1/2, L_s = H_i measured from the steady
@@ -57,6 +60,11 @@ fit_and_plot() {
   $C calibrate --db $R/regime_initiation.db --observations studies/field/observations.json --clear-of-front \
     --csv $R/regime_initiation_figures/clear_of_front_field_calibration.csv > $R/regime_initiation_figures/clear_of_front_field_calibration.txt
 }
+
+if [ "${1:-}" = "--fits-only" ]; then
+  fit_and_plot 1 2 4
+  exit 0
+fi
 
 $C study studies/regime_initiation_replicas.json --db $R/regime_initiation_replicas.db --keep-particles \
   --views $R/regime_initiation_replicas_views
