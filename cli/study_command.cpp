@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <cstdio>
+#include <string>
 #include <thread>
 
 #include "cli/cli_common.hpp"
@@ -93,13 +94,26 @@ class ConsoleObserver : public StudyObserver {
   }
 
   void on_progress(const RunnerProgress& p) override {
-    char line[256];
+    char line[384];
     std::snprintf(line, sizeof line,
-                  "%s: done %zu/%zu  failed %zu  running %zu  pending %zu  elapsed %s  ETA %s",
-                  name_.c_str(), p.done, p.total, p.failed, p.running, p.pending,
-                  format_duration(p.elapsed_s).c_str(),
+                  "%s: done %zu/%zu  failed %zu  running %zu%s  pending %zu  elapsed %s  ETA %s",
+                  name_.c_str(), p.done, p.total, p.failed, p.running,
+                  running_cases_text(p).c_str(), p.pending, format_duration(p.elapsed_s).c_str(),
                   p.eta_s ? format_duration(*p.eta_s).c_str() : "?");
     if (!printer_is_tty_throttled(p)) printer_.update(line);
+  }
+
+  // " (case 9 at 83%, case 10 at 51%)": a case that spans sittings shows where it is.
+  static std::string running_cases_text(const RunnerProgress& p) {
+    if (p.running_cases.empty() || p.running_cases.size() > 4) return "";
+    std::string s = " (";
+    for (std::size_t i = 0; i < p.running_cases.size(); ++i) {
+      char one[48];
+      std::snprintf(one, sizeof one, "%scase %zu at %.0f%%", i ? ", " : "",
+                    p.running_cases[i].first, 100.0 * p.running_cases[i].second);
+      s += one;
+    }
+    return s + ")";
   }
 
   void warn(const std::string& message) {

@@ -13,6 +13,7 @@
 #include <memory>
 #include <mutex>
 #include <new>
+#include <set>
 #include <thread>
 
 #include "analysis/measurement_io.hpp"
@@ -371,8 +372,13 @@ class StudyRun {
   std::exception_ptr write_events(int jobs) {
     std::exception_ptr writer_error;
     EtaEstimator eta(jobs);
+    std::set<std::size_t> running_slots;
     const auto update_progress = [&] {
       progress_.running = eta.running();
+      progress_.running_cases.clear();
+      for (const std::size_t slot : running_slots)
+        progress_.running_cases.emplace_back(todo_[slot]->index, progress_of_[slot].fraction.load());
+      std::sort(progress_.running_cases.begin(), progress_.running_cases.end());
       progress_.elapsed_s = seconds_since(t0_);
       eta.observe_running(
           [&](std::size_t slot) {
@@ -395,6 +401,7 @@ class StudyRun {
             case Event::Kind::started:
               store_.mark_running(c.case_id, report_.session_id, e.started_at, report_.threads_per_case);
               eta.started(e.slot, seconds_since(t0_));
+              running_slots.insert(e.slot);
               --progress_.pending;
               break;
             case Event::Kind::warning:
@@ -403,11 +410,13 @@ class StudyRun {
             case Event::Kind::cancelled:
               store_.mark_pending(c.case_id);
               eta.stopped(e.slot);
+              running_slots.erase(e.slot);
               ++progress_.pending;
               ++report_.cancelled;
               break;
             case Event::Kind::finished:
               store_.record_result(e.result);
+              running_slots.erase(e.slot);
               ++report_.ran;
               if (e.result.status == "done") {
                 ++report_.done;

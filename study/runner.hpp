@@ -11,6 +11,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "analysis/crevasse_measure.hpp"
@@ -32,6 +33,8 @@ struct RunnerProgress {
   std::size_t done = 0, failed = 0, running = 0, pending = 0;
   double elapsed_s = 0.0;
   std::optional<double> eta_s;
+  // The running cases: {StudyCase::index, how far it has got, 0 to 1}, by index.
+  std::vector<std::pair<std::size_t, double>> running_cases;
 };
 
 struct RunnerReport {

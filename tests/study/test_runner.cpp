@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <map>
 #include <mutex>
@@ -342,6 +343,38 @@ TEST(Runner, ReportsProgressToItsObserver) {
   EXPECT_EQ(obs.last.pending, 0u);
   EXPECT_EQ(obs.last.total, 4u);
   EXPECT_TRUE(obs.ended);
+}
+
+// A running case shows how far it has got: the observer sees it by its index while it runs,
+// and not once it has finished.
+class RunningCasesObserver : public StudyObserver {
+ public:
+  void on_progress(const RunnerProgress& p) override {
+    for (const auto& [index, fraction] : p.running_cases)
+      if (index == 2 && fraction == 0.25) seen.store(true);
+    last = p;
+  }
+  std::atomic<bool> seen{false};
+  RunnerProgress last;
+};
+
+TEST(Runner, ReportsHowFarEachRunningCaseHasGot) {
+  test::ScratchDir dir("runner");
+  const Study study = test::parse(test::tiny_study(3));
+  RunningCasesObserver obs;
+  RunnerOptions o = fake_options(dir / "s.db", [&](const StudyCase& c, CaseContext& ctx) {
+    if (c.index == 2) {
+      ctx.report_fraction(0.25);
+      // Progress is reported about once a second; wait for it, but not forever.
+      for (int i = 0; i < 100 && !obs.seen.load(); ++i)
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    return test::fake_outcome(c);
+  });
+  o.observer = &obs;
+  run_study(study, o);
+  EXPECT_TRUE(obs.seen.load()) << "case 2 was never reported at 25 %";
+  EXPECT_TRUE(obs.last.running_cases.empty());
 }
 
 // Real simulations: a few hundred steps of the tiny glacier per case, one engine thread each.
