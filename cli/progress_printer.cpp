@@ -23,6 +23,20 @@ std::string format_wall_time(double seconds) {
   return buf;
 }
 
+std::string format_running_cases(const std::vector<std::pair<std::size_t, double>>& cases) {
+  if (cases.empty()) return "";
+  constexpr std::size_t shown = 4;
+  std::string s = " (";
+  for (std::size_t i = 0; i < cases.size() && i < shown; ++i) {
+    char one[64];
+    std::snprintf(one, sizeof one, "%scase %zu at %.0f%%", i ? ", " : "", cases[i].first,
+                  100.0 * cases[i].second);
+    s += one;
+  }
+  if (cases.size() > shown) s += ", +" + std::to_string(cases.size() - shown) + " more";
+  return s + ")";
+}
+
 ProgressPrinter::ProgressPrinter(std::FILE* out) : out_(out), tty_(isatty(fileno(out)) != 0) {}
 
 void ProgressPrinter::update(const std::string& line) {

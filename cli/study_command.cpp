@@ -98,22 +98,10 @@ class ConsoleObserver : public StudyObserver {
     std::snprintf(line, sizeof line,
                   "%s: done %zu/%zu  failed %zu  running %zu%s  pending %zu  elapsed %s  ETA %s",
                   name_.c_str(), p.done, p.total, p.failed, p.running,
-                  running_cases_text(p).c_str(), p.pending, format_duration(p.elapsed_s).c_str(),
+                  format_running_cases(p.running_cases).c_str(), p.pending,
+                  format_duration(p.elapsed_s).c_str(),
                   p.eta_s ? format_duration(*p.eta_s).c_str() : "?");
     if (!printer_is_tty_throttled(p)) printer_.update(line);
-  }
-
-  // " (case 9 at 83%, case 10 at 51%)": a case that spans sittings shows where it is.
-  static std::string running_cases_text(const RunnerProgress& p) {
-    if (p.running_cases.empty() || p.running_cases.size() > 4) return "";
-    std::string s = " (";
-    for (std::size_t i = 0; i < p.running_cases.size(); ++i) {
-      char one[48];
-      std::snprintf(one, sizeof one, "%scase %zu at %.0f%%", i ? ", " : "",
-                    p.running_cases[i].first, 100.0 * p.running_cases[i].second);
-      s += one;
-    }
-    return s + ")";
   }
 
   void warn(const std::string& message) {

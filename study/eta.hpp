@@ -19,7 +19,8 @@ class EtaEstimator {
   // where (negative: it started fresh). A resumed case's speed counts from where it was first
   // seen after resuming, a fresh one's from its start.
   void observe(std::size_t slot, double fraction, double resumed_from, double now_s);
-  // observe() for every running case: read(slot) gives its {fraction, resumed_from}.
+  // observe() for every running case: read(slot), called once per running case, gives its
+  // {fraction, resumed_from}.
   template <class Read>
   void observe_running(Read read, double now_s) {
     for (auto& [slot, r] : running_) {

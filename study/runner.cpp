@@ -13,7 +13,6 @@
 #include <memory>
 #include <mutex>
 #include <new>
-#include <set>
 #include <thread>
 
 #include "analysis/measurement_io.hpp"
@@ -372,21 +371,19 @@ class StudyRun {
   std::exception_ptr write_events(int jobs) {
     std::exception_ptr writer_error;
     EtaEstimator eta(jobs);
-    std::set<std::size_t> running_slots;
     const auto update_progress = [&] {
       progress_.running = eta.running();
-      progress_.running_cases.clear();
-      for (const std::size_t slot : running_slots)
-        progress_.running_cases.emplace_back(todo_[slot]->index, progress_of_[slot].fraction.load());
-      std::sort(progress_.running_cases.begin(), progress_.running_cases.end());
       progress_.elapsed_s = seconds_since(t0_);
+      progress_.running_cases.clear();
       eta.observe_running(
           [&](std::size_t slot) {
             // In this order: a case says where it resumed from before it reports any fraction.
             const double fraction = progress_of_[slot].fraction.load();
+            progress_.running_cases.emplace_back(todo_[slot]->index, fraction);
             return std::pair{fraction, progress_of_[slot].resumed_from.load()};
           },
           progress_.elapsed_s);
+      std::sort(progress_.running_cases.begin(), progress_.running_cases.end());
       progress_.eta_s = eta.eta(progress_.pending, progress_.elapsed_s);
     };
     bool closed = false;
@@ -401,7 +398,6 @@ class StudyRun {
             case Event::Kind::started:
               store_.mark_running(c.case_id, report_.session_id, e.started_at, report_.threads_per_case);
               eta.started(e.slot, seconds_since(t0_));
-              running_slots.insert(e.slot);
               --progress_.pending;
               break;
             case Event::Kind::warning:
@@ -410,13 +406,11 @@ class StudyRun {
             case Event::Kind::cancelled:
               store_.mark_pending(c.case_id);
               eta.stopped(e.slot);
-              running_slots.erase(e.slot);
               ++progress_.pending;
               ++report_.cancelled;
               break;
             case Event::Kind::finished:
               store_.record_result(e.result);
-              running_slots.erase(e.slot);
               ++report_.ran;
               if (e.result.status == "done") {
                 ++report_.done;

@@ -345,8 +345,9 @@ TEST(Runner, ReportsProgressToItsObserver) {
   EXPECT_TRUE(obs.ended);
 }
 
-// A running case shows how far it has got: the observer sees it by its index while it runs,
-// and not once it has finished.
+// A running case shows how far it has got: the observer sees it by its index in the study (not
+// by its place among the cases this run starts: only 1 and 2 run, so case 2 is the second) while
+// it runs, and not once it has finished.
 class RunningCasesObserver : public StudyObserver {
  public:
   void on_progress(const RunnerProgress& p) override {
@@ -372,6 +373,7 @@ TEST(Runner, ReportsHowFarEachRunningCaseHasGot) {
     return test::fake_outcome(c);
   });
   o.observer = &obs;
+  o.only_cases = {1, 2};
   run_study(study, o);
   EXPECT_TRUE(obs.seen.load()) << "case 2 was never reported at 25 %";
   EXPECT_TRUE(obs.last.running_cases.empty());
