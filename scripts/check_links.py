@@ -11,13 +11,16 @@ bench/, fuzz/), in backticks, in a markdown link or in the prose, relative to th
 markdown link that is not one of those is resolved against the citing file's folder.
 Placeholders (`results/<name>.db`, `…/NAME/…`, `case_NNN_…`) and what a command writes (after
 --out, --csv, --views) are skipped, `{a,b}` is expanded, `*` must match at least one file, a
-stem (`analysis/plot`) may stand for its files and a `:line` suffix is dropped. Prints each missing path with file and line and exits 1
+stem (`analysis/plot`) may stand for its files and a `:line` suffix is dropped. In a git work
+tree a path must be tracked, as a fresh clone would have it. Prints each missing path with file and line and exits 1
 if there is any. --self-test checks the checker on a generated file with one dangling path.
 """
 import argparse
+import fnmatch
 import glob
 import os
 import re
+import subprocess
 import sys
 import tempfile
 
@@ -39,7 +42,32 @@ def expand_braces(path):
     return out
 
 
-def exists(root, path):
+def tracked_files(root):
+    """The files git tracks under root, or None outside a work tree: a path that exists only in
+    this working copy (kept particles, a local database) would be missing from a fresh clone."""
+    try:
+        out = subprocess.run(["git", "-C", root, "ls-files", "-z"], capture_output=True,
+                             check=True).stdout.decode("utf-8")
+    except (OSError, subprocess.CalledProcessError):
+        return None
+    files = set(f for f in out.split("\0") if f)
+    if not files:
+        return None
+    dirs = set()
+    for f in files:
+        d = os.path.dirname(f)
+        while d and d not in dirs:
+            dirs.add(d)
+            d = os.path.dirname(d)
+    return files | dirs
+
+
+def exists(root, path, tracked=None):
+    if tracked is not None:
+        p = os.path.normpath(path)
+        if "*" in p:
+            return any(fnmatch.fnmatchcase(f, p) for f in tracked)
+        return p in tracked or any(f.startswith(p + ".") and "/" not in f[len(p):] for f in tracked)
     full = os.path.join(root, path)
     if "*" in path:
         return bool(glob.glob(full))
@@ -66,13 +94,14 @@ def cited_paths(text):
 
 
 def check(root, files):
+    tracked = tracked_files(root)
     missing = []
     for f in files:
         with open(os.path.join(root, f), encoding="utf-8") as fh:
             text = fh.read()
         for n, path, relative in cited_paths(text):
             p = os.path.normpath(os.path.join(os.path.dirname(f), path)) if relative else path
-            if not exists(root, p):
+            if not exists(root, p, tracked):
                 missing.append(f"{f}:{n}: {path}")
     return missing
 
@@ -95,9 +124,18 @@ def self_test():
                      "`results/<name>.db` and `crevasse study studies/gone.json --db …`.\n"
                      "[missing](../results/lost.db)\n")
         got = check(root, ["docs/test.md"])
+        # In a git work tree a file git does not track counts as missing: a fresh clone lacks it.
+        tracked_case = subprocess.run(["git", "init", "-q", root], capture_output=True).returncode == 0
+        if tracked_case:
+            subprocess.run(["git", "-C", root, "add", "docs", "results/numerics/a.db"], check=True)
+            got_tracked = check(root, ["docs/test.md"])
     want = ["docs/test.md:2: studies/gone.json", "docs/test.md:3: ../results/lost.db"]
     if got != want:
         print(f"self-test failed: reported {got}, expected {want}")
+        return 1
+    want_tracked = ["docs/test.md:1: results/numerics/b.db"] + want
+    if tracked_case and got_tracked != want_tracked:
+        print(f"self-test failed in a git work tree: reported {got_tracked}, expected {want_tracked}")
         return 1
     print("self-test passed: the dangling paths are reported, the others are not")
     return 0
